@@ -1,0 +1,58 @@
+// Penalty contact (physics.md): a point on the solid side of a surface gets a rest-length-0
+// spring to its projection p on the surface,
+//   f = -kc (n.(x - p)) n - dc (n.v) n,   energy = 1/2 kc (n.(x - p))^2,
+// with n the unit normal pointing into free space. Walls: the six faces of the box [-2,2]^3,
+// one spring per violated wall. Plane: a*x+b*y+c*z+d = 0, solid where it is negative. Sphere:
+// solid inside, n radial.
+#pragma once
+
+#include "world.h"
+
+namespace jello {
+
+inline constexpr double kBoxHalfSize = 2.0;  // m: the box is [-2,2]^3
+
+struct ContactConstants {
+  double stiffness = 0.0;  // N/m (kCollision)
+  double damping = 0.0;    // N*s/m (dCollision)
+};
+
+// All arrays component-major, n points.
+class WallContact {
+ public:
+  explicit WallContact(ContactConstants k) : k_(k) {}
+  // True when every point is inside the box, so there is nothing to do.
+  static bool allInside(const double* x, int n);
+  void accumulate(const double* x, const double* v, double* f, int n) const;
+  double energy(const double* x, int n) const;
+
+ private:
+  ContactConstants k_;
+};
+
+class PlaneContact {
+ public:
+  PlaneContact(const Plane& plane, ContactConstants k);
+  void accumulate(const double* x, const double* v, double* f, int n) const;
+  double energy(const double* x, int n) const;
+  const Vec3& normal() const { return normal_; }  // unit, into free space
+  double offset() const { return offset_; }       // signed distance = normal.x + offset
+
+ private:
+  Vec3 normal_;
+  double offset_;
+  ContactConstants k_;
+};
+
+class SphereContact {
+ public:
+  SphereContact(const Sphere& sphere, ContactConstants k) : sphere_(sphere), k_(k) {}
+  void accumulate(const double* x, const double* v, double* f, int n) const;
+  double energy(const double* x, int n) const;
+
+ private:
+  Sphere sphere_;
+  ContactConstants k_;
+};
+
+}  // namespace jello

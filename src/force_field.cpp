@@ -1,0 +1,68 @@
+#include "force_field.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include "contact.h"
+
+namespace jello {
+namespace {
+
+// Cell index and fraction along one axis for a coordinate clamped to the box.
+void locate(double coord, int res, int& cell, double& frac) {
+  const double clamped = std::clamp(coord, -kBoxHalfSize, kBoxHalfSize);
+  const double s = (clamped + kBoxHalfSize) / (2.0 * kBoxHalfSize) * (res - 1);
+  cell = std::min(static_cast<int>(s), res - 2);
+  frac = s - cell;
+}
+
+}  // namespace
+
+FieldForces::FieldForces(ForceField field) : field_(std::move(field)) {
+  assert(field_.resolution >= 2);
+  assert(field_.forces.size() ==
+         static_cast<std::size_t>(field_.resolution) * field_.resolution * field_.resolution);
+  constant_ = field_.forces.front();
+  uniform_ = std::all_of(field_.forces.begin(), field_.forces.end(),
+                         [this](const Vec3& f) { return f == constant_; });
+}
+
+Vec3 FieldForces::sample(const Vec3& position) const {
+  if (uniform_) return constant_;
+  const int r = field_.resolution;
+  int i, j, k;
+  double fx, fy, fz;
+  locate(position.x, r, i, fx);
+  locate(position.y, r, j, fy);
+  locate(position.z, r, k, fz);
+  auto node = [&](int di, int dj, int dk) -> const Vec3& {
+    return field_.forces[static_cast<std::size_t>(((i + di) * r + (j + dj)) * r + (k + dk))];
+  };
+  // Interpolate along z, then y, then x.
+  auto lerp = [](const Vec3& a, const Vec3& b, double t) { return a * (1.0 - t) + b * t; };
+  const Vec3 c00 = lerp(node(0, 0, 0), node(0, 0, 1), fz);
+  const Vec3 c01 = lerp(node(0, 1, 0), node(0, 1, 1), fz);
+  const Vec3 c10 = lerp(node(1, 0, 0), node(1, 0, 1), fz);
+  const Vec3 c11 = lerp(node(1, 1, 0), node(1, 1, 1), fz);
+  return lerp(lerp(c00, c01, fy), lerp(c10, c11, fy), fx);
+}
+
+void FieldForces::accumulate(const double* x, double* f, int n) const {
+  if (uniform_) {
+    for (int p = 0; p < n; ++p) {
+      f[p] += constant_.x;
+      f[n + p] += constant_.y;
+      f[2 * n + p] += constant_.z;
+    }
+    return;
+  }
+  for (int p = 0; p < n; ++p) {
+    const Vec3 F = sample({x[p], x[n + p], x[2 * n + p]});
+    f[p] += F.x;
+    f[n + p] += F.y;
+    f[2 * n + p] += F.z;
+  }
+}
+
+}  // namespace jello

@@ -1,0 +1,29 @@
+// The external force field (world-format.md): forces F (N) on res^3 nodes covering [-2,2]^3,
+// node (i,j,k) at -2 + 4*(i,j,k)/(res-1), interpolated trilinearly between nodes. A point
+// outside the box takes the value at the nearest point of the box (its position is clamped).
+// A field whose nodes are all equal is a constant force and is applied as one (no
+// interpolation); an all-zero field is no effect at all (the Model leaves it out).
+#pragma once
+
+#include "world.h"
+
+namespace jello {
+
+class FieldForces {
+ public:
+  explicit FieldForces(ForceField field);
+
+  Vec3 sample(const Vec3& position) const;  // N
+  // Adds the field force at each of the n points (component-major x) to f.
+  void accumulate(const double* x, double* f, int n) const;
+
+  bool isUniform() const { return uniform_; }
+  bool isZero() const { return uniform_ && constant_ == Vec3{}; }
+
+ private:
+  ForceField field_;
+  bool uniform_ = false;
+  Vec3 constant_;
+};
+
+}  // namespace jello

@@ -1,0 +1,75 @@
+#include "model.h"
+
+#include <cassert>
+
+namespace jello {
+
+ModelSpec modelSpecFromWorld(const World& world) {
+  ModelSpec spec;
+  const Lattice lattice{world.cubeResolution};
+  spec.numPoints = lattice.numPoints();
+  spec.mass = world.mass;
+  spec.springs = latticeSpringGroups(lattice, world.kElastic, world.dElastic);
+  spec.contact = {world.kCollision, world.dCollision};
+  spec.plane = world.plane;
+  spec.sphere = world.sphere;
+  spec.field = world.field;
+  return spec;
+}
+
+Model::Model(ModelSpec spec)
+    : n_(spec.numPoints), mass_(spec.mass), springs_(std::move(spec.springs), spec.numPoints) {
+  assert(n_ > 0 && mass_ > 0.0);
+  if (spec.walls) walls_.emplace(spec.contact);
+  if (spec.plane) plane_.emplace(*spec.plane, spec.contact);
+  if (spec.sphere) sphere_.emplace(*spec.sphere, spec.contact);
+  if (!spec.field.empty()) {
+    FieldForces field(std::move(spec.field));
+    if (!field.isZero()) field_.emplace(std::move(field));
+  }
+}
+
+void Model::forces(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& f) const {
+  assert(x.size() == 3 * n_ && v.size() == 3 * n_);
+  f.setZero(3 * n_);
+  springs_.accumulate(x.data(), v.data(), f.data());
+  ++counts_.springs;
+  if (walls_) {
+    if (WallContact::allInside(x.data(), n_)) {
+      ++counts_.wallsSkipped;
+    } else {
+      walls_->accumulate(x.data(), v.data(), f.data(), n_);
+      ++counts_.walls;
+    }
+  }
+  if (plane_) {
+    plane_->accumulate(x.data(), v.data(), f.data(), n_);
+    ++counts_.plane;
+  }
+  if (sphere_) {
+    sphere_->accumulate(x.data(), v.data(), f.data(), n_);
+    ++counts_.sphere;
+  }
+  if (field_) {
+    field_->accumulate(x.data(), f.data(), n_);
+    ++counts_.field;
+  }
+}
+
+void Model::acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                         Eigen::VectorXd& a) const {
+  forces(x, v, a);
+  a *= 1.0 / mass_;
+}
+
+Energy Model::energy(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const {
+  Energy e;
+  e.kinetic = 0.5 * mass_ * v.squaredNorm();
+  e.spring = springs_.energy(x.data());
+  if (walls_) e.contact += walls_->energy(x.data(), n_);
+  if (plane_) e.contact += plane_->energy(x.data(), n_);
+  if (sphere_) e.contact += sphere_->energy(x.data(), n_);
+  return e;
+}
+
+}  // namespace jello

@@ -1,0 +1,88 @@
+// The physical model of a scene: n equal point masses and the effects the scene has.
+//   a = (sum of forces) / m
+// Effects: elastic springs (always), walls of the box [-2,2]^3 (skipped in a step where every
+// point is inside), and only when the scene has them: the inclined plane, the sphere, the force
+// field (an all-zero field is dropped, a uniform one is a constant force). This is the one seam
+// integrators use: forces/acceleration of a state, and its energy.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "contact.h"
+#include "force_field.h"
+#include "spring_forces.h"
+#include "state.h"
+#include "world.h"
+
+namespace jello {
+
+struct ModelSpec {
+  int numPoints = 0;
+  double mass = 0.0;  // kg, of each point
+  std::vector<SpringGroup> springs;
+  bool walls = true;
+  ContactConstants contact;
+  std::optional<Plane> plane;
+  std::optional<Sphere> sphere;
+  ForceField field;
+};
+
+// The lattice springs and every effect the world file describes.
+ModelSpec modelSpecFromWorld(const World& world);
+
+struct Energy {
+  double kinetic = 0.0;  // J
+  double spring = 0.0;   // J, elastic springs
+  double contact = 0.0;  // J, penalty springs of walls, plane and sphere
+  double total() const { return kinetic + spring + contact; }
+};
+
+// How often each effect was evaluated: lets tests check that absent effects cost nothing.
+struct EffectCounts {
+  long springs = 0;
+  long walls = 0;
+  long wallsSkipped = 0;  // evaluations where every point was inside the box
+  long plane = 0;
+  long sphere = 0;
+  long field = 0;
+};
+
+class Model {
+ public:
+  explicit Model(ModelSpec spec);
+  explicit Model(const World& world) : Model(modelSpecFromWorld(world)) {}
+
+  int numPoints() const { return n_; }
+  double mass() const { return mass_; }
+
+  // f = total force (N) at state (x, v); all vectors 3n, component-major. f is resized.
+  void forces(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& f) const;
+  // a = f / m (m/s^2).
+  void acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
+                    Eigen::VectorXd& a) const;
+
+  Energy energy(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const;
+  Energy energy(const State& s) const { return energy(s.x, s.v); }
+
+  const SpringForces& springs() const { return springs_; }
+  bool hasWalls() const { return walls_.has_value(); }
+  bool hasPlane() const { return plane_.has_value(); }
+  bool hasSphere() const { return sphere_.has_value(); }
+  bool hasField() const { return field_.has_value(); }
+  const EffectCounts& counts() const { return counts_; }
+
+ private:
+  int n_;
+  double mass_;
+  SpringForces springs_;
+  std::optional<WallContact> walls_;
+  std::optional<PlaneContact> plane_;
+  std::optional<SphereContact> sphere_;
+  std::optional<FieldForces> field_;
+  mutable EffectCounts counts_;
+};
+
+}  // namespace jello

@@ -1,0 +1,58 @@
+// Elastic springs: Hooke plus damping projected on the spring (physics.md).
+//   d = x_q - x_p, l = |d|, w = v_q - v_p
+//   f_p = [ k (1 - L0/l) + c (d.w)/l^2 ] d,   f_q = -f_p
+//   energy = 1/2 k (l - L0)^2
+// Springs come in groups that share a flat index offset, a rest length and constants: group g
+// links p -> p + delta for p in [first, first + mask.size()) where mask[p - first] != 0. On the
+// lattice every spring offset is one group, so the loop body reads contiguous memory and the
+// compiler vectorizes the square root and division, the cost that bounds a step.
+#pragma once
+
+#include <vector>
+
+#include "lattice.h"
+
+namespace jello {
+
+struct SpringGroup {
+  SpringKind kind = SpringKind::Structural;
+  int delta = 1;              // flat index offset from p to its partner
+  int first = 0;              // first base point
+  std::vector<double> mask;   // 1 where p -> p + delta is a spring, 0 where it is not
+  double rest = 0.0;          // m
+  double stiffness = 0.0;     // N/m
+  double damping = 0.0;       // N*s/m
+  int numSprings = 0;
+};
+
+struct Spring {
+  int a, b;     // point indices
+  double rest;  // m
+  SpringKind kind;
+};
+
+// Groups for every spring of the lattice, all with the same constants.
+std::vector<SpringGroup> latticeSpringGroups(const Lattice& lattice, double stiffness,
+                                             double damping);
+
+class SpringForces {
+ public:
+  SpringForces(std::vector<SpringGroup> groups, int numPoints);
+
+  // Adds the spring forces (N) of state (x, v) to f. All arrays component-major, 3n.
+  void accumulate(const double* x, const double* v, double* f) const;
+  double energy(const double* x) const;  // J
+
+  int numSprings() const { return numSprings_; }
+  const std::vector<SpringGroup>& groups() const { return groups_; }
+  // The same springs as a plain list (Jacobian assembly, drawing, tests).
+  std::vector<Spring> springs() const;
+
+ private:
+  std::vector<SpringGroup> groups_;
+  int n_;
+  int numSprings_ = 0;
+  mutable std::vector<double> gx_, gy_, gz_;  // per-group scratch: force on each base point
+};
+
+}  // namespace jello

@@ -1,0 +1,61 @@
+// The whole initial state of one jello scene, as a world file holds it (docs: README "World
+// files"). A World is plain data; loading checks it, building a Model turns it into effects.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "integrator_name.h"
+#include "vec3.h"
+
+namespace jello {
+
+// Inclined plane a*x + b*y + c*z + d = 0. The side where a*x+b*y+c*z+d > 0 is free space, the
+// other side is solid (the cube starts on the positive side in every reference world).
+struct Plane {
+  double a = 0.0, b = 0.0, c = 0.0, d = 0.0;  // a,b,c: normal (any length, not zero); d: m*|n|
+};
+
+// Solid sphere obstacle (world-file extension `sphere`).
+struct Sphere {
+  Vec3 center;          // m
+  double radius = 0.0;  // m, > 0
+};
+
+// Force field sampled on res^3 nodes covering the box [-2,2]^3; node (i,j,k) has flat index
+// i*res*res + j*res + k. resolution 0 means no field.
+struct ForceField {
+  int resolution = 0;
+  std::vector<Vec3> forces;  // N per node
+
+  bool empty() const { return resolution == 0; }
+};
+
+inline constexpr int kDefaultCubeResolution = 8;  // the only one the original format knows
+
+struct World {
+  IntegratorKind integrator = IntegratorKind::RK4;
+  double dt = 0.0005;     // s, time step
+  int stepsPerFrame = 1;  // n: integrator steps per drawn frame
+  double kElastic = 0.0;    // N/m, structural, shear and bend springs
+  double dElastic = 0.0;    // N*s/m, their damping along the spring
+  double kCollision = 0.0;  // N/m, contact penalty springs (walls, plane, sphere)
+  double dCollision = 0.0;  // N*s/m, their damping along the contact normal
+  double mass = 1.0 / 512;  // kg, of EACH point
+  std::optional<Plane> plane;
+  ForceField field;
+  int cubeResolution = kDefaultCubeResolution;  // N: N^3 points, spacing 1/(N-1)
+  std::vector<Vec3> positions;   // m, N^3 entries, point (i,j,k) at index i*N*N + j*N + k
+  std::vector<Vec3> velocities;  // m/s, N^3 entries
+  std::optional<Sphere> sphere;
+
+  int numPoints() const { return cubeResolution * cubeResolution * cubeResolution; }
+  // True when a file of this world needs the extension block (so the original loader would
+  // not read it as written).
+  bool usesExtensions() const {
+    return cubeResolution != kDefaultCubeResolution || sphere.has_value() ||
+           integrator == IntegratorKind::Symplectic;
+  }
+};
+
+}  // namespace jello

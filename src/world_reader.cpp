@@ -1,0 +1,267 @@
+#include "world_reader.h"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <system_error>
+#include <vector>
+
+namespace jello {
+namespace {
+
+constexpr std::string_view kEndOfFile = "<end of file>";
+
+struct Token {
+  std::string_view text;  // empty at end of file
+  int line = 0;
+};
+
+// Whitespace-separated tokens with their line numbers. '\r' is white space, so CRLF files read
+// like LF files, as with the original fscanf loader.
+class Tokenizer {
+ public:
+  Tokenizer(std::string_view text, std::string name) : text_(text), name_(std::move(name)) {}
+
+  Token next() {
+    skipSpace();
+    const std::size_t start = pos_;
+    while (pos_ < text_.size() && !isSpace(text_[pos_])) ++pos_;
+    return {text_.substr(start, pos_ - start), line_};
+  }
+
+  std::size_t remainingBytes() const { return text_.size() - pos_; }
+
+  [[noreturn]] void fail(const Token& t, const std::string& message) const {
+    const std::string token = t.text.empty() ? std::string(kEndOfFile) : std::string(t.text);
+    throw WorldFileError(name_, t.line, token, message);
+  }
+
+  double number(const char* what) {
+    const Token t = next();
+    return toNumber(t, what);
+  }
+
+  double toNumber(const Token& t, const char* what) const {
+    if (t.text.empty()) fail(t, std::string("file ends where ") + what + " was expected");
+    std::string_view s = t.text;
+    if (s.size() > 1 && s[0] == '+' && s[1] != '-') s.remove_prefix(1);  // fscanf accepts "+1"
+    double value = 0.0;
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
+    if (ec == std::errc::result_out_of_range) fail(t, std::string(what) + " is out of range");
+    if (ec != std::errc() || end != s.data() + s.size()) {
+      fail(t, std::string("expected a number for ") + what);
+    }
+    if (!std::isfinite(value)) fail(t, std::string(what) + " must be finite");
+    return value;
+  }
+
+  int integer(const char* what) {
+    const Token t = next();
+    if (t.text.empty()) fail(t, std::string("file ends where ") + what + " was expected");
+    int value = 0;
+    std::string_view s = t.text;
+    if (s.size() > 1 && s[0] == '+' && s[1] != '-') s.remove_prefix(1);
+    const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
+    if (ec == std::errc::result_out_of_range) fail(t, std::string(what) + " is out of range");
+    if (ec != std::errc() || end != s.data() + s.size()) {
+      fail(t, std::string("expected an integer for ") + what);
+    }
+    lastToken_ = t;
+    return value;
+  }
+
+  double positive(const char* what) {
+    const Token t = next();
+    const double v = toNumber(t, what);
+    if (!(v > 0.0)) fail(t, std::string(what) + " must be positive");
+    return v;
+  }
+
+  double nonNegative(const char* what) {
+    const Token t = next();
+    const double v = toNumber(t, what);
+    if (v < 0.0) fail(t, std::string(what) + " must not be negative");
+    return v;
+  }
+
+  const Token& lastToken() const { return lastToken_; }
+
+ private:
+  static bool isSpace(char c) {
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f';
+  }
+  void skipSpace() {
+    while (pos_ < text_.size() && isSpace(text_[pos_])) {
+      if (text_[pos_] == '\n') ++line_;
+      ++pos_;
+    }
+  }
+
+  std::string_view text_;
+  std::string name_;
+  std::size_t pos_ = 0;
+  int line_ = 1;
+  Token lastToken_;
+};
+
+bool isExtensionKeyword(std::string_view s) { return s == "cube" || s == "sphere"; }
+
+// Reads the extension block: one keyword per entry, each at most once.
+void readExtensions(Tokenizer& in, Token keyword, World& world, const ReaderLimits& limits) {
+  bool seenCube = false;
+  bool seenSphere = false;
+  while (!keyword.text.empty()) {
+    if (keyword.text == "cube") {
+      if (seenCube) in.fail(keyword, "extension 'cube' given twice");
+      seenCube = true;
+      const int n = in.integer("cube resolution");
+      if (n < 2 || n > limits.maxCubeResolution) {
+        in.fail(in.lastToken(), "cube resolution must be between 2 and " +
+                                    std::to_string(limits.maxCubeResolution));
+      }
+      world.cubeResolution = n;
+    } else if (keyword.text == "sphere") {
+      if (seenSphere) in.fail(keyword, "extension 'sphere' given twice");
+      seenSphere = true;
+      Sphere s;
+      s.center.x = in.number("sphere centre x");
+      s.center.y = in.number("sphere centre y");
+      s.center.z = in.number("sphere centre z");
+      s.radius = in.positive("sphere radius");
+      world.sphere = s;
+    } else {
+      in.fail(keyword, "unknown trailing content (extension keywords: cube, sphere)");
+    }
+    keyword = in.next();
+  }
+}
+
+}  // namespace
+
+WorldFileError::WorldFileError(std::string file, int line, std::string token,
+                               const std::string& message)
+    : std::runtime_error(file + ":" + std::to_string(line) + ": " + message + " (at '" + token +
+                         "')"),
+      file_(std::move(file)),
+      line_(line),
+      token_(std::move(token)) {}
+
+World parseWorld(std::string_view text, const std::string& name, const ReaderLimits& limits) {
+  Tokenizer in(text, name);
+  World w;
+
+  const Token integrator = in.next();
+  if (integrator.text.empty()) in.fail(integrator, "empty file: no integrator name");
+  const auto kind = parseIntegratorName(integrator.text);
+  if (!kind) in.fail(integrator, "unknown integrator (known: " + integratorNameList() + ")");
+  w.integrator = *kind;
+
+  w.dt = in.positive("the time step dt");
+  w.stepsPerFrame = in.integer("n (steps per frame)");
+  if (w.stepsPerFrame < 1) in.fail(in.lastToken(), "n (steps per frame) must be at least 1");
+  w.kElastic = in.nonNegative("kElastic");
+  w.dElastic = in.nonNegative("dElastic");
+  w.kCollision = in.nonNegative("kCollision");
+  w.dCollision = in.nonNegative("dCollision");
+  w.mass = in.positive("the point mass");
+
+  if (in.integer("the plane flag") == 1) {
+    const Token first = in.next();
+    Plane p;
+    p.a = in.toNumber(first, "plane a");
+    p.b = in.number("plane b");
+    p.c = in.number("plane c");
+    p.d = in.number("plane d");
+    if (p.a == 0.0 && p.b == 0.0 && p.c == 0.0) in.fail(first, "the plane normal (a,b,c) is zero");
+    w.plane = p;
+  }
+
+  const int res = in.integer("the force-field resolution");
+  const Token resToken = in.lastToken();
+  if (res < 0 || res == 1 || res > limits.maxFieldResolution) {
+    in.fail(resToken, "force-field resolution must be 0 (none) or between 2 and " +
+                          std::to_string(limits.maxFieldResolution));
+  }
+  if (res > 0) {
+    const std::size_t nodes = static_cast<std::size_t>(res) * res * res;
+    // Each of the 3*nodes numbers needs at least a digit and a separator: refuse before
+    // allocating when the file cannot hold them.
+    if (in.remainingBytes() + 1 < nodes * 3 * 2) {
+      in.fail(resToken, "file is too short for a force field of resolution " +
+                            std::to_string(res) + " (" + std::to_string(nodes) + " nodes)");
+    }
+    w.field.resolution = res;
+    w.field.forces.resize(nodes);
+    for (Vec3& f : w.field.forces) {
+      f.x = in.number("force-field x");
+      f.y = in.number("force-field y");
+      f.z = in.number("force-field z");
+    }
+  }
+
+  // Positions and velocities: their count depends on the cube resolution, which an extension
+  // given after them may set, so collect numbers up to the first keyword.
+  std::vector<double> values;
+  std::vector<Token> tokens;
+  values.reserve(6 * 512);
+  tokens.reserve(6 * 512);
+  Token t = in.next();
+  while (!t.text.empty() && !isExtensionKeyword(t.text)) {
+    values.push_back(in.toNumber(t, "a position or velocity"));
+    tokens.push_back(t);
+    t = in.next();
+  }
+  readExtensions(in, t, w, limits);
+
+  const std::size_t points = static_cast<std::size_t>(w.numPoints());
+  const std::size_t expected = 6 * points;
+  if (values.size() < expected) {
+    const bool inPositions = values.size() < 3 * points;
+    const std::string block = inPositions ? "positions" : "velocities";
+    const std::size_t got = inPositions ? values.size() : values.size() - 3 * points;
+    const Token where{{}, tokens.empty() ? t.line : tokens.back().line};
+    in.fail(where, "truncated: " + std::to_string(got / 3) + " of " + std::to_string(points) +
+                       " " + block + " (cube resolution " +
+                       std::to_string(w.cubeResolution) + ")");
+  }
+  if (values.size() > expected) {
+    in.fail(tokens[expected], "unknown trailing content after the " + std::to_string(points) +
+                                  " velocities (cube resolution " +
+                                  std::to_string(w.cubeResolution) + ")");
+  }
+  w.positions.resize(points);
+  w.velocities.resize(points);
+  for (std::size_t p = 0; p < points; ++p) {
+    w.positions[p] = {values[3 * p], values[3 * p + 1], values[3 * p + 2]};
+    const std::size_t q = 3 * (points + p);
+    w.velocities[p] = {values[q], values[q + 1], values[q + 2]};
+  }
+  return w;
+}
+
+World readWorld(const std::filesystem::path& path, const ReaderLimits& limits) {
+  const std::string name = path.string();
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw WorldFileError(name, 0, name, "is a directory, not a world file");
+  }
+  const std::uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec) throw WorldFileError(name, 0, name, "cannot open: " + ec.message());
+  if (size > limits.maxFileBytes) {
+    throw WorldFileError(name, 0, name,
+                         "file is larger than the reader allows (" +
+                             std::to_string(limits.maxFileBytes) + " bytes)");
+  }
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw WorldFileError(name, 0, name, "cannot open for reading");
+  std::string text(static_cast<std::size_t>(size), '\0');
+  file.read(text.data(), static_cast<std::streamsize>(size));
+  if (file.gcount() != static_cast<std::streamsize>(size)) {
+    throw WorldFileError(name, 0, name, "read failed");
+  }
+  return parseWorld(text, name, limits);
+}
+
+}  // namespace jello
