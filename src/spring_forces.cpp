@@ -56,49 +56,101 @@ SpringForces::SpringForces(std::vector<SpringGroup> groups, int numPoints)
   gz_.resize(longest);
 }
 
+namespace {
+
+// Partners at least this far apart can be updated in the same vectorized pass: within 8
+// consecutive springs no point is both a base and a partner.
+constexpr int kFusedMinDelta = 8;
+
+// The scalar the force on the base point is d times (see the header).
+inline double springScale(double dx, double dy, double dz, double wx, double wy, double wz,
+                          double k, double c, double L0, double mask) {
+  const double l2 = dx * dx + dy * dy + dz * dz;
+  const double inv = 1.0 / std::sqrt(l2);
+  const double scale = k * (1.0 - L0 * inv) + c * (dx * wx + dy * wy + dz * wz) * (inv * inv);
+  return mask != 0.0 ? scale : 0.0;  // a select, so 0 * inf never makes a NaN
+}
+
+// A group with delta >= kFusedMinDelta: one pass adds the force to both ends. Arrays are
+// component arrays offset to the group's first base point.
+void accumulateGroupFused(const SpringGroup& g, std::ptrdiff_t count, const double* __restrict x,
+                          const double* __restrict y, const double* __restrict z,
+                          const double* __restrict vx, const double* __restrict vy,
+                          const double* __restrict vz, double* fx, double* fy, double* fz) {
+  const double k = g.stiffness, c = g.damping, L0 = g.rest;
+  const double* __restrict mask = g.mask.data();
+  const std::ptrdiff_t d = g.delta;
+#pragma omp simd safelen(kFusedMinDelta)
+  for (std::ptrdiff_t s = 0; s < count; ++s) {
+    const double dx = x[s + d] - x[s], dy = y[s + d] - y[s], dz = z[s + d] - z[s];
+    const double scale = springScale(dx, dy, dz, vx[s + d] - vx[s], vy[s + d] - vy[s],
+                                     vz[s + d] - vz[s], k, c, L0, mask[s]);
+    fx[s] += scale * dx;
+    fy[s] += scale * dy;
+    fz[s] += scale * dz;
+    fx[s + d] -= scale * dx;
+    fy[s + d] -= scale * dy;
+    fz[s + d] -= scale * dz;
+  }
+}
+
+// One group: springs p -> p + delta for the base points p = first .. first + count - 1. The
+// arrays are passed as separate restrict pointers, offset to the group's base and partner
+// points, so the compiler sees unit-stride loops without aliasing and vectorizes them.
+void accumulateGroup(const SpringGroup& g, std::ptrdiff_t count, const double* __restrict xp,
+                     const double* __restrict yp, const double* __restrict zp,
+                     const double* __restrict xq, const double* __restrict yq,
+                     const double* __restrict zq, const double* __restrict vxp,
+                     const double* __restrict vyp, const double* __restrict vzp,
+                     const double* __restrict vxq, const double* __restrict vyq,
+                     const double* __restrict vzq, double* __restrict fxp,
+                     double* __restrict fyp, double* __restrict fzp, double* __restrict gx,
+                     double* __restrict gy, double* __restrict gz) {
+  const double k = g.stiffness, c = g.damping, L0 = g.rest;
+  const double* __restrict mask = g.mask.data();
+  // Pass 1: the force on each base point, added in place (base points run unit-stride).
+  for (std::ptrdiff_t s = 0; s < count; ++s) {
+    const double dx = xq[s] - xp[s], dy = yq[s] - yp[s], dz = zq[s] - zp[s];
+    const double scale = springScale(dx, dy, dz, vxq[s] - vxp[s], vyq[s] - vyp[s],
+                                     vzq[s] - vzp[s], k, c, L0, mask[s]);
+    gx[s] = scale * dx;
+    gy[s] = scale * dy;
+    gz[s] = scale * dz;
+    fxp[s] += gx[s];
+    fyp[s] += gy[s];
+    fzp[s] += gz[s];
+  }
+}
+
+// Pass 2: the opposite force on the partners, in its own loop since q may alias p + 1.
+void subtractFromPartners(std::ptrdiff_t count, const double* __restrict gx,
+                          const double* __restrict gy, const double* __restrict gz,
+                          double* __restrict fxq, double* __restrict fyq,
+                          double* __restrict fzq) {
+  for (std::ptrdiff_t s = 0; s < count; ++s) {
+    fxq[s] -= gx[s];
+    fyq[s] -= gy[s];
+    fzq[s] -= gz[s];
+  }
+}
+
+}  // namespace
+
 void SpringForces::accumulate(const double* x, const double* v, double* f) const {
   const int n = n_;
-  const double* __restrict X = x;
-  const double* __restrict Y = x + n;
-  const double* __restrict Z = x + 2 * n;
-  const double* __restrict VX = v;
-  const double* __restrict VY = v + n;
-  const double* __restrict VZ = v + 2 * n;
-  double* __restrict FX = f;
-  double* __restrict FY = f + n;
-  double* __restrict FZ = f + 2 * n;
-  double* __restrict gx = gx_.data();
-  double* __restrict gy = gy_.data();
-  double* __restrict gz = gz_.data();
-
   for (const SpringGroup& g : groups_) {
-    const int count = static_cast<int>(g.mask.size());
-    const int p0 = g.first;
-    const int q0 = g.first + g.delta;
-    const double k = g.stiffness, c = g.damping, L0 = g.rest;
-    const double* __restrict mask = g.mask.data();
-    // Pass 1: the force on each base point; it can be added in place since p runs unit-stride.
-    for (int s = 0; s < count; ++s) {
-      const int p = p0 + s, q = q0 + s;
-      const double dx = X[q] - X[p], dy = Y[q] - Y[p], dz = Z[q] - Z[p];
-      const double wx = VX[q] - VX[p], wy = VY[q] - VY[p], wz = VZ[q] - VZ[p];
-      const double l2 = dx * dx + dy * dy + dz * dz;
-      const double inv = 1.0 / std::sqrt(l2);
-      double scale = k * (1.0 - L0 * inv) + c * (dx * wx + dy * wy + dz * wz) * (inv * inv);
-      scale = mask[s] != 0.0 ? scale : 0.0;  // a select, so 0 * inf never makes a NaN
-      gx[s] = scale * dx;
-      gy[s] = scale * dy;
-      gz[s] = scale * dz;
-      FX[p] += gx[s];
-      FY[p] += gy[s];
-      FZ[p] += gz[s];
+    const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(g.mask.size());
+    const int p = g.first, q = g.first + g.delta;
+    if (g.delta >= kFusedMinDelta) {
+      accumulateGroupFused(g, count, x + p, x + n + p, x + 2 * n + p, v + p, v + n + p,
+                           v + 2 * n + p, f + p, f + n + p, f + 2 * n + p);
+      continue;
     }
-    // Pass 2: the opposite force on the partners (a separate loop: p + delta may alias p + 1).
-    for (int s = 0; s < count; ++s) {
-      FX[q0 + s] -= gx[s];
-      FY[q0 + s] -= gy[s];
-      FZ[q0 + s] -= gz[s];
-    }
+    accumulateGroup(g, count, x + p, x + n + p, x + 2 * n + p, x + q, x + n + q, x + 2 * n + q,
+                    v + p, v + n + p, v + 2 * n + p, v + q, v + n + q, v + 2 * n + q, f + p,
+                    f + n + p, f + 2 * n + p, gx_.data(), gy_.data(), gz_.data());
+    subtractFromPartners(count, gx_.data(), gy_.data(), gz_.data(), f + q, f + n + q,
+                         f + 2 * n + q);
   }
 }
 

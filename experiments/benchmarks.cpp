@@ -1,0 +1,60 @@
+// Speed of the core (Google Benchmark; run on one core, e.g. `taskset -c 0 build/release/
+// experiments/benchmarks`). Figures are reported in the README with the machine.
+//   BM_SpringForces/N    one evaluation of every spring; items/s = spring evaluations/s
+//   BM_Step/<integrator>/N  one full step on jello.w resampled to N^3; items/s = steps/s
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <memory>
+
+#include "simulation.h"
+#include "world_reader.h"
+#include "scene_builder.h"
+
+namespace {
+
+const jello::World& jelloWorld() {
+  static const jello::World world =
+      jello::readWorld(std::filesystem::path(JELLO_WORLDS_DIR) / "jello.w");
+  return world;
+}
+
+void BM_SpringForces(benchmark::State& state) {
+  const jello::World world = jello::resampleCube(jelloWorld(), static_cast<int>(state.range(0)));
+  const jello::Model model(world);
+  const jello::State s = jello::initialState(world);
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(s.x.size());
+  for (auto _ : state) {
+    model.springs().accumulate(s.x.data(), s.v.data(), f.data());
+    benchmark::DoNotOptimize(f.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * model.springs().numSprings());
+  state.counters["springs"] = model.springs().numSprings();
+}
+BENCHMARK(BM_SpringForces)->Arg(8)->Arg(16)->Arg(32);
+
+void BM_Step(benchmark::State& state, jello::IntegratorKind kind) {
+  const jello::World world = jello::resampleCube(jelloWorld(), static_cast<int>(state.range(0)));
+  auto sim = std::make_unique<jello::Simulation>(world, kind);
+  long restarts = 0;
+  for (auto _ : state) {
+    if (!sim->step().ok) {
+      // Explicit Euler diverges on jello.w after ~12 s at rest on the plane: start the scene
+      // again, outside the timing, and count it.
+      state.PauseTiming();
+      sim = std::make_unique<jello::Simulation>(world, kind);
+      ++restarts;
+      state.ResumeTiming();
+    }
+  }
+  state.counters["restarts"] = static_cast<double>(restarts);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK_CAPTURE(BM_Step, rk4, jello::IntegratorKind::RK4)->Arg(8)->Arg(16)->Arg(32);
+BENCHMARK_CAPTURE(BM_Step, euler, jello::IntegratorKind::Euler)->Arg(8);
+BENCHMARK_CAPTURE(BM_Step, symplectic, jello::IntegratorKind::Symplectic)->Arg(8);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,153 @@
+// jello-create-world: writes a world file. With no arguments it writes ./jello.w with the
+// original course creator's values (reference-worlds/createWorld-default.w); flags set every
+// field. The file is checked by reading it back before it replaces anything on disk.
+#include <cstdio>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "atomic_file.h"
+#include "scene_builder.h"
+#include "world_reader.h"
+#include "world_writer.h"
+
+namespace {
+
+using jello::FieldPreset;
+using jello::PosePreset;
+using jello::Vec3;
+
+Vec3 toVec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  jello::SceneSpec spec;
+  std::string out = "jello.w";
+  std::string integrator = "rk4";
+  std::vector<double> plane, sphere, velocity, translate, axis;
+  std::optional<double> fieldStrength;
+  bool noPlane = false, legacy = false;
+
+  CLI::App app{
+      "Writes a jello world file. With no arguments: ./jello.w with the original course "
+      "creator's values (RK4, dt 0.0005, k 200, plane -x+y+z+2=0, zero 30^3 field, "
+      "skewed corner, velocity (10,-10,20)).",
+      "jello-create-world"};
+  app.add_option("-o,--output", out, "File to write (default jello.w)");
+  app.add_option("--integrator", integrator, "Integrator: " + jello::integratorNameList())
+      ->capture_default_str();
+  app.add_option("--dt", spec.dt, "Time step, s")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("-n,--steps-per-frame", spec.stepsPerFrame, "Steps per drawn frame")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
+  app.add_option("--k-elastic", spec.kElastic, "Spring stiffness, N/m")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--d-elastic", spec.dElastic, "Spring damping, N*s/m")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--k-collision", spec.kCollision, "Contact stiffness, N/m")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--d-collision", spec.dCollision, "Contact damping, N*s/m")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--mass", spec.mass, "Mass of each point, kg (default 1/512)")
+      ->check(CLI::PositiveNumber);
+  auto* planeOpt = app.add_option("--plane", plane, "Inclined plane A B C D: Ax+By+Cz+D=0, "
+                                                    "free where positive (default -1 1 1 2)")
+                       ->expected(4);
+  app.add_flag("--no-plane", noPlane, "No inclined plane")->excludes(planeOpt);
+
+  const std::map<std::string, FieldPreset> fields{{"none", FieldPreset::None},
+                                                  {"gravity", FieldPreset::Gravity},
+                                                  {"vortex", FieldPreset::Vortex},
+                                                  {"radial", FieldPreset::Radial}};
+  app.add_option("--field", spec.field,
+                 "Force field: none (zero), gravity F=(0,0,-s), vortex F=s(-y,x,0), "
+                 "radial F=-s(x,y,z)")
+      ->transform(CLI::CheckedTransformer(fields, CLI::ignore_case));
+  app.add_option("--field-strength", fieldStrength,
+                 "s above; default: gravity 9.81*mass N, vortex 5*mass N/m (rotate.w), "
+                 "radial 25*mass N/m");
+  app.add_option("--field-resolution", spec.fieldResolution,
+                 "Field nodes per axis, 2..128, or 0 for no field (default 30)")
+      ->check(CLI::Range(0, 128));
+
+  const std::map<std::string, PosePreset> poses{{"rest", PosePreset::Rest},
+                                                {"skewed", PosePreset::SkewedCorner},
+                                                {"stretched", PosePreset::Stretched},
+                                                {"rotated", PosePreset::Rotated},
+                                                {"translated", PosePreset::Translated}};
+  app.add_option("--pose", spec.pose,
+                 "Initial pose: rest, skewed (far corner out by one spacing; default), "
+                 "stretched, rotated, translated")
+      ->transform(CLI::CheckedTransformer(poses, CLI::ignore_case));
+  app.add_option("--stretch", spec.stretch, "Stretch factor along x for --pose stretched")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--rotate", spec.rotateDegrees, "Angle, degrees, for --pose rotated")
+      ->capture_default_str();
+  app.add_option("--axis", axis, "Rotation axis X Y Z for --pose rotated (default 1 1 1)")
+      ->expected(3);
+  app.add_option("--translate", translate, "Offset X Y Z, m, for --pose translated "
+                                           "(default 0.5 0.5 0.5)")
+      ->expected(3);
+  app.add_option("--velocity", velocity, "Uniform initial velocity VX VY VZ, m/s "
+                                         "(default 10 -10 20)")
+      ->expected(3);
+  app.add_option("--spin", spec.spin,
+                 "Initial spin about the vertical axis through the cube's centre, rad/s");
+  app.add_option("--sphere", sphere, "Sphere obstacle CX CY CZ R (an extension)")->expected(4);
+  app.add_option("--cube", spec.cubeResolution,
+                 "Cube resolution N: N^3 points (default 8; other values are an extension)")
+      ->check(CLI::Range(2, 64));
+  app.add_flag("--legacy", legacy,
+               "Print six decimals like the original creator (not exact: 1/512 becomes "
+               "0.001953)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+
+  const auto kind = jello::parseIntegratorName(integrator);
+  if (!kind) {
+    std::fprintf(stderr, "jello-create-world: error: unknown integrator '%s' (known: %s)\n",
+                 integrator.c_str(), jello::integratorNameList().c_str());
+    return 2;
+  }
+  spec.integrator = *kind;
+  if (noPlane) spec.plane.reset();
+  if (!plane.empty()) spec.plane = jello::Plane{plane[0], plane[1], plane[2], plane[3]};
+  if (!sphere.empty()) spec.sphere = jello::Sphere{{sphere[0], sphere[1], sphere[2]}, sphere[3]};
+  if (!velocity.empty()) spec.velocity = toVec3(velocity);
+  if (!translate.empty()) spec.translate = toVec3(translate);
+  if (!axis.empty()) spec.rotateAxis = toVec3(axis);
+  spec.fieldStrength = fieldStrength.value_or(jello::defaultFieldStrength(spec.field, spec.mass));
+  if (spec.pose == PosePreset::Rotated && jello::norm(spec.rotateAxis) == 0.0) {
+    std::fprintf(stderr, "jello-create-world: error: --axis must not be zero\n");
+    return 2;
+  }
+
+  const jello::World world = jello::buildWorld(spec);
+  const std::string text =
+      jello::formatWorld(world, legacy ? jello::NumberFormat::Legacy : jello::NumberFormat::Exact);
+  try {
+    // Whatever the flags, the file must load: check it before it replaces anything.
+    (void)jello::parseWorld(text, out);
+    jello::writeFileAtomically(out, text);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "jello-create-world: error: %s\n", e.what());
+    return 1;
+  }
+  std::printf("wrote %s (%d points%s%s%s)\n", out.c_str(), world.numPoints(),
+              world.plane ? ", plane" : "", world.sphere ? ", sphere" : "",
+              world.field.resolution ? ", field" : "");
+  return 0;
+}

@@ -1,0 +1,206 @@
+// jello-sim: steps a world headless and reports what happened.
+//   jello-sim WORLD [--integrator NAME] [--dt S] [--time S | --steps N] [--cube N]
+//             [--out FILE.w] [--trace FILE.csv --every K] [--stats FILE.json] [--quiet]
+// Exit codes: 0 done, 1 bad input or an I/O failure, 2 bad usage, 3 the simulation diverged.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <sstream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "atomic_file.h"
+#include "progress.h"
+#include "scene_builder.h"
+#include "simulation.h"
+#include "world_reader.h"
+#include "world_writer.h"
+
+namespace {
+
+using jello::Energy;
+using jello::Simulation;
+
+constexpr int kExitInput = 1;
+constexpr int kExitUsage = 2;
+constexpr int kExitDiverged = 3;
+
+struct Options {
+  std::string world;
+  std::string integrator;
+  std::optional<double> dt;
+  std::optional<double> time;
+  std::optional<long> steps;
+  std::optional<int> cube;
+  std::string out, trace, stats;
+  long every = 100;
+  bool quiet = false;
+};
+
+nlohmann::json toJson(const Energy& e) {
+  return {{"kinetic_J", e.kinetic},
+          {"spring_J", e.spring},
+          {"contact_J", e.contact},
+          {"total_J", e.total()}};
+}
+
+class Trace {
+ public:
+  explicit Trace(bool on) : on_(on) {
+    if (on_) csv_ << "step,t_s,kinetic_J,spring_J,contact_J,total_J,com_x_m,com_y_m,com_z_m\n";
+  }
+  void row(const Simulation& sim) {
+    if (!on_) return;
+    const jello::State& s = sim.state();
+    const Energy e = sim.model().energy(s);
+    const Eigen::Index n = s.numPoints();
+    char buf[320];
+    std::snprintf(buf, sizeof buf, "%ld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
+                  sim.steps(), s.t, e.kinetic, e.spring, e.contact, e.total(),
+                  s.x.head(n).mean(), s.x.segment(n, n).mean(), s.x.tail(n).mean());
+    csv_ << buf;
+  }
+  std::string text() const { return csv_.str(); }
+
+ private:
+  bool on_;
+  std::ostringstream csv_;
+};
+
+int run(const Options& opt) {
+  jello::World world;
+  try {
+    world = jello::readWorld(opt.world);
+  } catch (const jello::WorldFileError& e) {
+    std::fprintf(stderr, "jello-sim: error: %s\n", e.what());
+    return kExitInput;
+  }
+  if (opt.cube) world = jello::resampleCube(world, *opt.cube);
+
+  std::optional<jello::IntegratorKind> kind;
+  if (!opt.integrator.empty()) {
+    kind = jello::parseIntegratorName(opt.integrator);
+    if (!kind) {
+      std::fprintf(stderr, "jello-sim: error: unknown integrator '%s' (known: %s)\n",
+                   opt.integrator.c_str(), jello::integratorNameList().c_str());
+      return kExitUsage;
+    }
+  }
+  Simulation sim(std::move(world), kind, opt.dt);
+  const double dt = sim.dt();
+  const long total = opt.steps ? *opt.steps
+                               : static_cast<long>(std::ceil(opt.time.value_or(1.0) / dt - 1e-9));
+  const Energy start = sim.model().energy(sim.state());
+  const std::string name(jello::integratorName(sim.integrator()));
+
+  Trace trace(!opt.trace.empty());
+  trace.row(sim);
+  jello::Progress progress(!opt.quiet, name + " steps");
+  const auto t0 = std::chrono::steady_clock::now();
+  bool diverged = false;
+  for (long i = 0; i < total; ++i) {
+    if (!sim.step().ok) {
+      diverged = true;
+      break;
+    }
+    if (sim.steps() % opt.every == 0) trace.row(sim);
+    progress.update(i + 1, total);
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  progress.finish();
+
+  const jello::State& s = sim.state();
+  const long done = diverged ? sim.steps() - 1 : sim.steps();
+  const Energy end = sim.model().energy(s);
+  nlohmann::json stats = {
+      {"world", opt.world},
+      {"integrator", name},
+      {"dt_s", dt},
+      {"points", s.numPoints()},
+      {"springs", sim.model().springs().numSprings()},
+      {"steps", done},
+      {"simulated_time_s", s.t},
+      {"wall_time_s", wall},
+      {"steps_per_s", wall > 0 ? double(done) / wall : 0.0},
+      {"real_time_factor", wall > 0 ? s.t / wall : 0.0},
+      {"energy_start", toJson(start)},
+      {"energy_end", toJson(end)},
+      {"diverged", diverged},
+  };
+  if (diverged) {
+    const jello::Divergence& d = *sim.divergence();
+    stats["divergence"] = {{"time_s", d.time}, {"step", d.step}, {"reason", d.reason}};
+    std::fprintf(stderr, "jello-sim: %s\n", d.describe().c_str());
+  }
+
+  if (!opt.quiet) {
+    std::printf("world        %s (%d points, %d springs)\n", opt.world.c_str(), s.numPoints(),
+                sim.model().springs().numSprings());
+    std::printf("integrator   %s, dt = %g s\n", name.c_str(), dt);
+    std::printf("steps        %ld%s\n", done, diverged ? " (then diverged)" : "");
+    std::printf("simulated    %.6g s\n", s.t);
+    std::printf("wall time    %.3f s (%.0f steps/s, %.2fx real time)\n", wall,
+                wall > 0 ? double(done) / wall : 0.0, wall > 0 ? s.t / wall : 0.0);
+    std::printf("energy (J)   %12s %12s %12s %12s\n", "kinetic", "spring", "contact", "total");
+    std::printf("  start      %12.6g %12.6g %12.6g %12.6g\n", start.kinetic, start.spring,
+                start.contact, start.total());
+    std::printf("  %-10s %12.6g %12.6g %12.6g %12.6g\n", diverged ? "last sane" : "end",
+                end.kinetic, end.spring, end.contact, end.total());
+  }
+
+  try {
+    if (!opt.trace.empty()) jello::writeFileAtomically(opt.trace, trace.text());
+    if (!opt.stats.empty()) jello::writeFileAtomically(opt.stats, stats.dump(2) + "\n");
+    // A diverged run saves no world: its last state is not the state at the requested time.
+    if (!opt.out.empty() && !diverged) jello::writeWorld(sim.currentWorld(), opt.out);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "jello-sim: error: %s\n", e.what());
+    return kExitInput;
+  }
+  if (diverged && !opt.out.empty()) {
+    std::fprintf(stderr, "jello-sim: %s not written (the simulation diverged)\n",
+                 opt.out.c_str());
+  }
+  return diverged ? kExitDiverged : 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options opt;
+  CLI::App app{
+      "Steps a jello world headless and prints a summary: steps, simulated and wall time, "
+      "steps/s, real-time factor, energy at start and end.\n"
+      "Exit codes: 0 done, 1 bad world file or I/O failure, 2 bad usage, 3 diverged.",
+      "jello-sim"};
+  app.add_option("world", opt.world, "World file (.w)")->required();
+  app.add_option("--integrator", opt.integrator,
+                 "Integrator, overriding the file's: " + jello::integratorNameList());
+  app.add_option("--dt", opt.dt, "Time step in seconds, overriding the file's")
+      ->check(CLI::PositiveNumber);
+  auto* time = app.add_option("--time", opt.time, "Simulated time to run, s (default 1)")
+                   ->check(CLI::PositiveNumber);
+  app.add_option("--steps", opt.steps, "Number of steps to run instead of --time")
+      ->check(CLI::NonNegativeNumber)
+      ->excludes(time);
+  app.add_option("--cube", opt.cube,
+                 "Resample the cube to N^3 points (initial state interpolated)")
+      ->check(CLI::Range(2, 64));
+  app.add_option("--out", opt.out, "Write the final state as a world file");
+  auto* trace = app.add_option("--trace", opt.trace, "Write energies and centre of mass (CSV)");
+  app.add_option("--every", opt.every, "Trace every K steps (default 100)")
+      ->check(CLI::PositiveNumber)
+      ->needs(trace);
+  app.add_option("--stats", opt.stats, "Write the summary as JSON");
+  app.add_flag("--quiet,-q", opt.quiet, "Print nothing but errors");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : kExitUsage;
+  }
+  return run(opt);
+}
