@@ -108,6 +108,20 @@ class Tokenizer {
 
 bool isExtensionKeyword(std::string_view s) { return s == "cube" || s == "sphere"; }
 
+bool looksNumeric(std::string_view s) {
+  const char c = s.front();
+  return (c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.';
+}
+
+// True when `count` numbers are the positions and velocities of some N^3 cube, N >= 2: a word
+// after them is trailing content, not a bad number.
+bool completeCube(std::size_t count) {
+  if (count == 0 || count % 6 != 0) return false;
+  const std::size_t points = count / 6;
+  const auto n = static_cast<std::size_t>(std::llround(std::cbrt(static_cast<double>(points))));
+  return n >= 2 && n * n * n == points;
+}
+
 // Reads the extension block: one keyword per entry, each at most once.
 void readExtensions(Tokenizer& in, Token keyword, World& world, const ReaderLimits& limits) {
   bool seenCube = false;
@@ -209,6 +223,10 @@ World parseWorld(std::string_view text, const std::string& name, const ReaderLim
   tokens.reserve(6 * 512);
   Token t = in.next();
   while (!t.text.empty() && !isExtensionKeyword(t.text)) {
+    if (completeCube(values.size()) && !looksNumeric(t.text)) {
+      in.fail(t, "unknown trailing content after the velocities (extension keywords: cube, "
+                 "sphere)");
+    }
     values.push_back(in.toNumber(t, "a position or velocity"));
     tokens.push_back(t);
     t = in.next();

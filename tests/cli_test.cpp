@@ -1,0 +1,178 @@
+// jello-sim and jello-create-world as a user runs them: exit codes, messages, files.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "scene_builder.h"
+#include "test_support.h"
+#include "world_reader.h"
+#include "world_writer.h"
+
+namespace jello {
+namespace {
+
+struct Outcome {
+  int code;
+  std::string output;  // stdout and stderr
+};
+
+Outcome run(const std::string& command) {
+  std::string output;
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return {-1, "popen failed"};
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) output.append(buf, n);
+  const int status = ::pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+std::string sim() { return JELLO_SIM; }
+std::string create() { return JELLO_CREATE_WORLD; }
+std::string world(const char* name) { return (test::worldsDir() / name).string(); }
+bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+
+TEST(JelloSim, RunsAWorldAndPrintsTheSummary) {
+  const Outcome r = run(sim() + " " + world("jello.w") + " --steps 200");
+  EXPECT_EQ(r.code, 0) << r.output;
+  for (const char* part : {"steps        200", "simulated    0.1 s", "steps/s", "real time",
+                           "kinetic", "spring", "total"}) {
+    EXPECT_TRUE(contains(r.output, part)) << part << "\n" << r.output;
+  }
+}
+
+TEST(JelloSim, WritesTheFinalStateStatsAndTrace) {
+  test::TempDir dir;
+  const auto out = dir.path() / "end.w", stats = dir.path() / "s.json",
+             trace = dir.path() / "t.csv";
+  const Outcome r = run(sim() + " " + world("moveLeft.w") + " --time 0.05 --quiet --out " +
+                    out.string() + " --stats " + stats.string() + " --trace " + trace.string() +
+                    " --every 10");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output, "");
+  const World end = readWorld(out);
+  EXPECT_FALSE(end.usesExtensions());  // the original course code could load it
+  EXPECT_EQ(end.integrator, IntegratorKind::RK4);
+  EXPECT_LT(end.positions[0].x, 0.0);  // moved left
+
+  const auto json = nlohmann::json::parse(test::readFile(stats));
+  EXPECT_EQ(json["steps"], 100);
+  EXPECT_EQ(json["integrator"], "rk4");
+  EXPECT_EQ(json["diverged"], false);
+  EXPECT_GT(json["energy_start"]["total_J"].get<double>(), 0.0);
+
+  const std::string csv = test::readFile(trace);
+  EXPECT_EQ(csv.rfind("step,t_s,kinetic_J,spring_J,contact_J,total_J,", 0), 0u);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 11);  // header, steps 0..100 by 10
+}
+
+TEST(JelloSim, ReportsDivergenceWithExitCodeThreeAndWritesNoWorld) {
+  test::TempDir dir;
+  SceneSpec spec;
+  spec.kElastic = 1e4;
+  spec.dElastic = 0.0;
+  const auto stiff = dir.path() / "stiff.w", out = dir.path() / "out.w";
+  writeWorld(buildWorld(spec), stiff);
+  const Outcome r = run(sim() + " " + stiff.string() + " --integrator rk4 --dt 0.01 --out " +
+                    out.string());
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_TRUE(contains(r.output, "diverged at t = ")) << r.output;
+  EXPECT_TRUE(contains(r.output, "integrator rk4")) << r.output;
+  EXPECT_FALSE(contains(r.output, "nan")) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(JelloSim, RefusesABadWorldNamingFileAndLine) {
+  test::TempDir dir;
+  const auto bad = dir.path() / "bad.w";
+  std::ofstream(bad) << "RK4\n0.001 1\n1 2 x 4\n";
+  const Outcome r = run(sim() + " " + bad.string());
+  EXPECT_EQ(r.code, 1);
+  EXPECT_TRUE(contains(r.output, bad.string() + ":3: ")) << r.output;
+  EXPECT_TRUE(contains(r.output, "'x'")) << r.output;
+}
+
+TEST(JelloSim, AnswersBadUsageWithExitCodeTwo) {
+  EXPECT_EQ(run(sim()).code, 2);
+  EXPECT_EQ(run(sim() + " " + world("jello.w") + " --integrator verlet").code, 2);
+  EXPECT_EQ(run(sim() + " " + world("jello.w") + " --dt -1").code, 2);
+  const Outcome help = run(sim() + " --help");
+  EXPECT_EQ(help.code, 0);
+  EXPECT_TRUE(contains(help.output, "--integrator")) << help.output;
+}
+
+TEST(JelloSim, ResamplesTheCube) {
+  const Outcome r = run(sim() + " " + world("jello.w") + " --cube 12 --steps 20");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "1728 points")) << r.output;
+}
+
+TEST(JelloCreateWorld, WithNoArgumentsWritesTheOriginalDefaultWorld) {
+  test::TempDir dir;
+  const Outcome r = run("cd " + dir.path().string() + " && " + create());
+  ASSERT_EQ(r.code, 0) << r.output;
+  const World made = readWorld(dir.path() / "jello.w");
+  const World original = test::loadWorld("createWorld-default.w");
+  // Equal to the six decimals the original printed (its mass 0.001953 is our exact 1/512).
+  EXPECT_EQ(formatWorld(made, NumberFormat::Legacy), formatWorld(original, NumberFormat::Legacy));
+  EXPECT_EQ(made.mass, 1.0 / 512);
+}
+
+TEST(JelloCreateWorld, LegacyOutputIsByteIdenticalToTheOriginalCreator) {
+  test::TempDir dir;
+  const auto out = dir.path() / "legacy.w";
+  ASSERT_EQ(run(create() + " --legacy -o " + out.string()).code, 0);
+  EXPECT_EQ(test::readFile(out), test::readFile(test::worldsDir() / "createWorld-default.w"));
+}
+
+TEST(JelloCreateWorld, FlagsSetEveryField) {
+  test::TempDir dir;
+  const auto out = dir.path() / "w.w";
+  const Outcome r = run(create() + " -o " + out.string() +
+                    " --integrator symplectic --dt 0.002 -n 3 --k-elastic 1000"
+                    " --d-elastic 0.5 --k-collision 2000 --d-collision 0.7 --mass 0.004"
+                    " --plane 0 0 1 1.5 --field vortex --field-strength 0.1"
+                    " --field-resolution 5 --pose rotated --rotate 45 --axis 0 0 1"
+                    " --velocity 1 2 3 --spin 2 --sphere 0 0 -1 0.5 --cube 6");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const World w = readWorld(out);
+  EXPECT_EQ(w.integrator, IntegratorKind::Symplectic);
+  EXPECT_EQ(w.dt, 0.002);
+  EXPECT_EQ(w.stepsPerFrame, 3);
+  EXPECT_EQ(w.kElastic, 1000);
+  EXPECT_EQ(w.dElastic, 0.5);
+  EXPECT_EQ(w.kCollision, 2000);
+  EXPECT_EQ(w.dCollision, 0.7);
+  EXPECT_EQ(w.mass, 0.004);
+  ASSERT_TRUE(w.plane.has_value());
+  EXPECT_EQ(w.plane->d, 1.5);
+  EXPECT_EQ(w.field.resolution, 5);
+  EXPECT_NEAR(w.field.forces[0].x, 0.1 * 2.0, 1e-15);  // s * -y at y = -2
+  EXPECT_EQ(w.cubeResolution, 6);
+  ASSERT_TRUE(w.sphere.has_value());
+  EXPECT_EQ(w.sphere->radius, 0.5);
+  // Rotated 45 degrees about z through the centre: the cube's centre of mass stays put.
+  Vec3 centre;
+  for (const Vec3& x : w.positions) centre += x * (1.0 / static_cast<double>(w.positions.size()));
+  EXPECT_NEAR(centre.x, 0.5, 1e-12);
+  EXPECT_NEAR(centre.z, 0.5, 1e-12);
+  EXPECT_NEAR(w.velocities[0].z, 3.0, 1e-12);
+}
+
+TEST(JelloCreateWorld, RefusesBadValuesAndWritesNothing) {
+  test::TempDir dir;
+  const auto out = dir.path() / "w.w";
+  EXPECT_EQ(run(create() + " -o " + out.string() + " --dt 0").code, 2);
+  EXPECT_EQ(run(create() + " -o " + out.string() + " --integrator leapfrog").code, 2);
+  EXPECT_EQ(run(create() + " -o " + out.string() + " --plane 0 0 0 1").code, 1);
+  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_NE(run(create() + " -o /nonexistent/dir/w.w").code, 0);
+}
+
+}  // namespace
+}  // namespace jello

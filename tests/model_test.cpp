@@ -1,0 +1,85 @@
+// The model builds only the effects a scene has, and absent effects are never evaluated.
+#include <gtest/gtest.h>
+
+#include "model.h"
+#include "scene_builder.h"
+#include "test_support.h"
+
+namespace jello {
+namespace {
+
+TEST(Model, BuildsOnlyTheEffectsTheSceneHas) {
+  const Model moveLeft(test::loadWorld("moveLeft.w"));  // no plane, all-zero field
+  EXPECT_TRUE(moveLeft.hasWalls());
+  EXPECT_FALSE(moveLeft.hasPlane());
+  EXPECT_FALSE(moveLeft.hasField());
+  EXPECT_FALSE(moveLeft.hasSphere());
+
+  const Model rotate(test::loadWorld("rotate.w"));
+  EXPECT_TRUE(rotate.hasPlane());
+  EXPECT_TRUE(rotate.hasField());
+}
+
+TEST(Model, AnAbsentEffectIsNotEvaluated) {
+  const World w = test::loadWorld("moveLeft.w");
+  const Model model(w);
+  const State s = initialState(w);
+  Eigen::VectorXd f;
+  for (int i = 0; i < 5; ++i) model.forces(s.x, s.v, f);
+  EXPECT_EQ(model.counts().springs, 5);
+  EXPECT_EQ(model.counts().plane, 0);
+  EXPECT_EQ(model.counts().sphere, 0);
+  EXPECT_EQ(model.counts().field, 0);
+  EXPECT_EQ(model.counts().walls, 0);  // the cube starts inside the box
+  EXPECT_EQ(model.counts().wallsSkipped, 5);
+}
+
+TEST(Model, WallsAreEvaluatedOnceAPointIsOutside) {
+  World w = test::loadWorld("moveLeft.w");
+  w.positions[0].x = -2.01;
+  const Model model(w);
+  const State s = initialState(w);
+  Eigen::VectorXd f, g;
+  model.forces(s.x, s.v, f);
+  EXPECT_EQ(model.counts().walls, 1);
+  EXPECT_GT(f[0], 0.0);  // pushed back in +x
+
+  World inside = w;
+  inside.positions[0].x = 0.0;
+  const Model free(inside);
+  const State t = initialState(inside);
+  free.forces(t.x, t.v, g);
+  EXPECT_EQ(free.counts().wallsSkipped, 1);
+}
+
+TEST(Model, AUniformFieldAddsTheSameForceToEveryPoint) {
+  const World w = test::loadWorld("gravity.w");
+  const Model model(w);
+  ModelSpec noField = modelSpecFromWorld(w);
+  noField.field = {};
+  const Model without(noField);
+  const State s = initialState(w);
+  Eigen::VectorXd f, g;
+  model.forces(s.x, s.v, f);
+  without.forces(s.x, s.v, g);
+  const int n = model.numPoints();
+  for (int p = 0; p < n; ++p) {
+    EXPECT_NEAR(f[2 * n + p] - g[2 * n + p], -0.06, 1e-15);
+    EXPECT_EQ(f[p], g[p]);
+  }
+}
+
+TEST(Model, EnergyAddsKineticSpringAndContact) {
+  World w = test::loadWorld("jello.w");
+  w.positions[5].z = 2.1;  // into the top wall by 0.1 m
+  const Model model(w);
+  const State s = initialState(w);
+  const Energy e = model.energy(s);
+  EXPECT_NEAR(e.kinetic, 0.5 * 512 * 0.001953 * (100 + 100 + 400), 1e-9);
+  EXPECT_NEAR(e.contact, 0.5 * 400 * 0.1 * 0.1, 1e-12);
+  EXPECT_GT(e.spring, 0.0);
+  EXPECT_DOUBLE_EQ(e.total(), e.kinetic + e.spring + e.contact);
+}
+
+}  // namespace
+}  // namespace jello

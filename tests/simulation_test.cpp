@@ -1,0 +1,100 @@
+// The simulation loop: integrator choice, divergence detection, saving the state.
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "simulation.h"
+#include "test_support.h"
+#include "world_reader.h"
+#include "world_writer.h"
+
+namespace jello {
+namespace {
+
+World stiff(double k) {
+  World w = test::loadWorld("skewedCorner.w");
+  w.kElastic = k;
+  w.dElastic = 0.0;
+  return w;
+}
+
+TEST(Simulation, UsesTheWorldsIntegratorAndDtUnlessOverridden) {
+  const World w = test::loadWorld("rotate.w");
+  const Simulation a(w);
+  EXPECT_EQ(a.integrator(), IntegratorKind::RK4);
+  EXPECT_EQ(a.dt(), 0.001);
+  const Simulation b(w, IntegratorKind::Symplectic, 1e-4);
+  EXPECT_EQ(b.integrator(), IntegratorKind::Symplectic);
+  EXPECT_EQ(b.dt(), 1e-4);
+}
+
+TEST(Simulation, DetectsDivergenceAtTheStepItHappensAndKeepsTheLastSaneState) {
+  // k = 10^4 undamped at dt = 0.01: h w_max is about 9000, far beyond any explicit limit.
+  Simulation sim(stiff(1e4), IntegratorKind::Euler, 0.01);
+  long steps = 0;
+  while (sim.step().ok) ASSERT_LT(++steps, 1000);
+  ASSERT_TRUE(sim.divergence().has_value());
+  const Divergence& d = *sim.divergence();
+  EXPECT_EQ(d.step, steps + 1);
+  EXPECT_EQ(d.integrator, IntegratorKind::Euler);
+  EXPECT_DOUBLE_EQ(d.time, static_cast<double>(steps) * 0.01);
+  EXPECT_FALSE(findDivergence(sim.state()).has_value());  // the last sane state
+  EXPECT_FALSE(sim.step().ok);                            // and it stays stopped
+  EXPECT_NE(d.describe().find("integrator euler"), std::string::npos);
+}
+
+TEST(Simulation, RK4AlsoDivergesOnAStiffSceneAtALargeStep) {
+  Simulation sim(stiff(1e5), IntegratorKind::RK4, 0.01);
+  bool diverged = false;
+  for (int i = 0; i < 1000 && !diverged; ++i) diverged = !sim.step().ok;
+  EXPECT_TRUE(diverged);
+}
+
+TEST(Simulation, FindsNonFiniteValuesAndFarPoints) {
+  State s = initialState(test::loadWorld("jello.w"));
+  EXPECT_FALSE(findDivergence(s).has_value());
+  State nan = s;
+  nan.v[100] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(findDivergence(nan).has_value());
+  State far = s;
+  far.x[7] = -150.0;
+  EXPECT_TRUE(findDivergence(far).has_value());
+}
+
+TEST(Simulation, SwitchingIntegratorKeepsTheState) {
+  Simulation sim(test::loadWorld("jello.w"));
+  for (int i = 0; i < 10; ++i) ASSERT_TRUE(sim.step().ok);
+  const State before = sim.state();
+  sim.setIntegrator(IntegratorKind::Symplectic);
+  EXPECT_EQ(sim.integrator(), IntegratorKind::Symplectic);
+  EXPECT_EQ(sim.state().x, before.x);
+  ASSERT_TRUE(sim.step().ok);
+  EXPECT_NEAR(sim.state().t, before.t + sim.dt(), 1e-15);
+}
+
+TEST(Simulation, SavedStateReadsBackBitExactly) {
+  Simulation sim(test::loadWorld("gravity.w"));
+  for (int i = 0; i < 50; ++i) ASSERT_TRUE(sim.step().ok);
+  const World saved = parseWorld(formatWorld(sim.currentWorld()), "saved");
+  const State s = initialState(saved);
+  EXPECT_EQ(s.x, sim.state().x);
+  EXPECT_EQ(s.v, sim.state().v);
+}
+
+TEST(Simulation, EveryReferenceWorldRunsATenthOfASecondWithItsOwnSettings) {
+  for (const char* name : {"jello.w", "moveLeft.w", "rotate.w", "gravity.w",
+                           "createWorld-default.w"}) {
+    Simulation sim(test::loadWorld(name));
+    const long steps = std::lround(0.1 / sim.dt());
+    for (long i = 0; i < steps; ++i) ASSERT_TRUE(sim.step().ok) << name << " step " << i;
+    if (sim.model().hasField()) continue;  // a field does work: energy may rise
+    EXPECT_LE(sim.model().energy(sim.state()).total(),
+              sim.model().energy(initialState(sim.world())).total() * 1.001)
+        << name;
+  }
+  Simulation skewed(test::loadWorld("skewedCorner.w"));  // dt = 1e-5: 0.01 s is 1000 steps
+  for (int i = 0; i < 1000; ++i) ASSERT_TRUE(skewed.step().ok);
+}
+
+}  // namespace
+}  // namespace jello

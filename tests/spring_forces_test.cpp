@@ -1,0 +1,121 @@
+// Spring forces against their energy, conservation laws, and an analytic solution.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "explicit_integrators.h"
+#include "model.h"
+#include "test_support.h"
+
+namespace jello {
+namespace {
+
+// jello.w with every point displaced at random: no spring at rest length.
+State deformedJello(const World& w, unsigned seed, double amount) {
+  State s = initialState(w);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-amount, amount);
+  for (Eigen::Index i = 0; i < s.x.size(); ++i) s.x[i] += u(rng);
+  for (Eigen::Index i = 0; i < s.v.size(); ++i) s.v[i] = u(rng) * 100;
+  return s;
+}
+
+TEST(SpringForces, EqualMinusTheGradientOfTheSpringEnergy) {
+  const World w = test::loadWorld("jello.w");
+  const Model model(test::freeCube(w));
+  State s = deformedJello(w, 1, 0.03);
+  s.v.setZero();  // damping forces are not conservative
+  Eigen::VectorXd f;
+  model.forces(s.x, s.v, f);
+  const double h = 1e-6;
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < s.x.size(); i += 7) {
+    Eigen::VectorXd xp = s.x, xm = s.x;
+    xp[i] += h;
+    xm[i] -= h;
+    const double grad = (model.springs().energy(xp.data()) - model.springs().energy(xm.data())) /
+                        (2 * h);
+    worst = std::max(worst, std::abs(f[i] + grad) / (std::abs(f[i]) + 1e-3));
+  }
+  EXPECT_LT(worst, 1e-6);
+}
+
+TEST(SpringForces, ConserveLinearAndAngularMomentumWithDamping) {
+  const World w = test::loadWorld("jello.w");
+  const Model model(test::freeCube(w));
+  const State s = deformedJello(w, 2, 0.05);
+  Eigen::VectorXd f;
+  model.forces(s.x, s.v, f);
+  const int n = model.numPoints();
+  Vec3 total, torque;
+  double scale = 0.0;
+  for (int p = 0; p < n; ++p) {
+    const Vec3 fp = State::at(f, p);
+    total += fp;
+    torque += cross(s.position(p), fp);
+    scale += norm(fp);
+  }
+  EXPECT_LT(norm(total), 1e-12 * scale);
+  EXPECT_LT(norm(torque), 1e-12 * scale);
+}
+
+TEST(SpringForces, FreeCubeKeepsItsMomentumUnderRK4) {
+  const World w = test::loadWorld("jello.w");
+  const Model model(test::freeCube(w));
+  State s = initialState(w);
+  auto momentum = [&](const State& st) {
+    Vec3 m;
+    for (int p = 0; p < st.numPoints(); ++p) m += st.velocity(p) * model.mass();
+    return m;
+  };
+  const Vec3 start = momentum(s);
+  RungeKutta4 rk4;
+  for (int i = 0; i < 400; ++i) ASSERT_TRUE(rk4.step(model, s, w.dt).ok);
+  const Vec3 end = momentum(s);
+  EXPECT_LT(norm(end - start), 1e-11 * norm(start));
+}
+
+TEST(SingleSpring, MatchesItsAnalyticSolution) {
+  // Two masses m on a spring k, stretched by A from rest: the length oscillates as
+  // L0 + A cos(w t) with w = sqrt(2k/m) (reduced mass m/2).
+  const double k = 50.0, m = 0.01, L0 = 0.3, A = 0.05;
+  const Model model(test::singleSpring(k, 0.0, L0, m));
+  State s;
+  s.x = Eigen::VectorXd::Zero(6);
+  s.v = Eigen::VectorXd::Zero(6);
+  s.x[1] = L0 + A;  // point 1 x
+  const double w = std::sqrt(2 * k / m), h = 1e-4;
+  RungeKutta4 rk4;
+  double worst = 0.0;
+  for (int i = 1; i <= 2000; ++i) {
+    ASSERT_TRUE(rk4.step(model, s, h).ok);
+    const double length = s.x[1] - s.x[0];
+    worst = std::max(worst, std::abs(length - (L0 + A * std::cos(w * s.t))));
+    EXPECT_NEAR(s.x[0] + s.x[1], L0 + A, 1e-12);  // centre of mass at rest
+  }
+  EXPECT_LT(worst, 1e-9);
+}
+
+TEST(SingleSpring, DampingRemovesEnergyAtTheAnalyticRate) {
+  // Relative motion: (m/2) l'' = -k (l - L0) - c l'. Energy ratio after time t of a weakly
+  // damped oscillator decays as exp(-2 zeta w t) on average; check one full period.
+  const double k = 50.0, m = 0.01, c = 0.01, L0 = 0.3, A = 0.05;
+  const Model model(test::singleSpring(k, c, L0, m));
+  State s;
+  s.x = Eigen::VectorXd::Zero(6);
+  s.v = Eigen::VectorXd::Zero(6);
+  s.x[1] = L0 + A;
+  const double mu = m / 2, w0 = std::sqrt(k / mu), gamma = c / (2 * mu);
+  const double wd = std::sqrt(w0 * w0 - gamma * gamma), h = 1e-5;
+  RungeKutta4 rk4;
+  for (int i = 0; i < 5000; ++i) ASSERT_TRUE(rk4.step(model, s, h).ok);
+  // Exact damped solution with l(0) = L0 + A, l'(0) = 0.
+  const double t = s.t;
+  const double exact =
+      L0 + A * std::exp(-gamma * t) * (std::cos(wd * t) + gamma / wd * std::sin(wd * t));
+  EXPECT_NEAR(s.x[1] - s.x[0], exact, 1e-9);
+}
+
+}  // namespace
+}  // namespace jello

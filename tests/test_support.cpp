@@ -1,0 +1,62 @@
+#include "test_support.h"
+
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "world_reader.h"
+
+namespace jello::test {
+
+std::filesystem::path worldsDir() { return JELLO_WORLDS_DIR; }
+
+World loadWorld(const std::string& name) { return readWorld(worldsDir() / name); }
+
+std::string readFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TempDir::TempDir() {
+  std::random_device rd;
+  path_ = std::filesystem::temp_directory_path() /
+          ("jello-test-" + std::to_string(rd()) + std::to_string(rd()));
+  std::filesystem::create_directories(path_);
+}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  std::filesystem::permissions(path_, std::filesystem::perms::owner_all,
+                               std::filesystem::perm_options::add, ec);
+  std::filesystem::remove_all(path_, ec);
+}
+
+ModelSpec singleSpring(double stiffness, double damping, double rest, double mass) {
+  ModelSpec spec;
+  spec.numPoints = 2;
+  spec.mass = mass;
+  SpringGroup g;
+  g.delta = 1;
+  g.first = 0;
+  g.mask = {1.0};
+  g.rest = rest;
+  g.stiffness = stiffness;
+  g.damping = damping;
+  g.numSprings = 1;
+  spec.springs.push_back(g);
+  spec.walls = false;
+  return spec;
+}
+
+ModelSpec freeCube(const World& world) {
+  ModelSpec spec = modelSpecFromWorld(world);
+  spec.walls = false;
+  spec.plane.reset();
+  spec.sphere.reset();
+  spec.field = {};
+  return spec;
+}
+
+}  // namespace jello::test

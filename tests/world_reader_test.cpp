@@ -1,0 +1,244 @@
+// The reader against the six reference worlds and every class of bad input.
+#include <gtest/gtest.h>
+
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "scene_builder.h"
+#include "test_support.h"
+#include "world_reader.h"
+#include "world_writer.h"
+
+namespace jello {
+namespace {
+
+struct Header {
+  friend void PrintTo(const Header& h, std::ostream* os) { *os << h.file; }
+  std::string file;
+  double dt;
+  double kElastic, kCollision;
+  std::optional<Plane> plane;
+  Vec3 firstFieldNode;
+  Vec3 velocity;       // of every point
+  bool skewedCorner;   // p[7][7][7] = (8/7, 8/7, 8/7)
+};
+
+class ReferenceWorld : public ::testing::TestWithParam<Header> {};
+
+TEST_P(ReferenceWorld, LoadsWithItsHeaderValues) {
+  const Header& h = GetParam();
+  const World w = test::loadWorld(h.file);
+  EXPECT_EQ(w.integrator, IntegratorKind::RK4);
+  EXPECT_EQ(w.dt, h.dt);
+  EXPECT_EQ(w.stepsPerFrame, 1);
+  EXPECT_EQ(w.kElastic, h.kElastic);
+  EXPECT_EQ(w.dElastic, 0.25);
+  EXPECT_EQ(w.kCollision, h.kCollision);
+  EXPECT_EQ(w.dCollision, 0.25);
+  EXPECT_EQ(w.mass, 0.001953);  // 1/512 printed with six decimals
+  ASSERT_EQ(w.plane.has_value(), h.plane.has_value());
+  if (h.plane) {
+    EXPECT_EQ(w.plane->a, h.plane->a);
+    EXPECT_EQ(w.plane->b, h.plane->b);
+    EXPECT_EQ(w.plane->c, h.plane->c);
+    EXPECT_EQ(w.plane->d, h.plane->d);
+  }
+  ASSERT_EQ(w.field.resolution, 30);
+  ASSERT_EQ(w.field.forces.size(), 27000u);
+  EXPECT_EQ(w.field.forces.front(), h.firstFieldNode);
+  EXPECT_EQ(w.cubeResolution, 8);
+  ASSERT_EQ(w.positions.size(), 512u);
+  ASSERT_EQ(w.velocities.size(), 512u);
+  const Lattice lat{8};
+  for (int i = 0; i < 8; ++i)
+    for (int j = 0; j < 8; ++j)
+      for (int k = 0; k < 8; ++k) {
+        const int p = lat.index(i, j, k);
+        const double scale = (h.skewedCorner && p == 511) ? 8.0 / 7.0 : 1.0;
+        const Vec3 expected = p == 511 ? Vec3{scale, scale, scale} : lat.restPosition(i, j, k);
+        EXPECT_NEAR(w.positions[p].x, expected.x, 5e-7) << p;
+        EXPECT_NEAR(w.positions[p].y, expected.y, 5e-7) << p;
+        EXPECT_NEAR(w.positions[p].z, expected.z, 5e-7) << p;
+        EXPECT_EQ(w.velocities[p], h.velocity) << p;
+      }
+  EXPECT_FALSE(w.sphere.has_value());
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    AllSix, ReferenceWorld,
+    ::testing::Values(
+        Header{"jello.w", 0.0005, 200, 400, Plane{-1, 1, 1, 2}, {}, {10, -10, 20}, true},
+        Header{"createWorld-default.w", 0.0005, 200, 400, Plane{-1, 1, 1, 2}, {}, {10, -10, 20},
+               true},
+        Header{"moveLeft.w", 0.0005, 500, 1000, std::nullopt, {}, {-50, 0, 0}, false},
+        Header{"rotate.w", 0.001, 500, 1000, Plane{1, -1, -1, 4}, {0.019531, -0.019531, 0},
+               {0, 0, 0}, false},
+        Header{"skewedCorner.w", 0.00001, 500, 1000, std::nullopt, {}, {0, 0, 0}, true},
+        Header{"gravity.w", 0.0001, 500, 1000, Plane{-1, 1, 2, 6}, {0, 0, -0.06}, {10, -10, 0},
+               false}),
+    [](const auto& param_info) {
+      std::string name = param_info.param.file.substr(0, param_info.param.file.find('.'));
+      name.erase(std::remove(name.begin(), name.end(), '-'), name.end());
+      return name;
+    });
+
+TEST(ReferenceWorlds, RotateFieldIsTheVortexAtEveryNode) {
+  const World w = test::loadWorld("rotate.w");
+  const int r = w.field.resolution;
+  for (int i = 0; i < r; ++i)
+    for (int j = 0; j < r; ++j)
+      for (int k = 0; k < r; ++k) {
+        const double x = -2.0 + 4.0 * i / (r - 1), y = -2.0 + 4.0 * j / (r - 1);
+        const Vec3& f = w.field.forces[(i * r + j) * r + k];
+        EXPECT_NEAR(f.x, 5.0 / 512 * -y, 5e-7);
+        EXPECT_NEAR(f.y, 5.0 / 512 * x, 5e-7);
+        EXPECT_EQ(f.z, 0.0);
+      }
+}
+
+TEST(ReferenceWorlds, CrlfLineEndingsReadLikeLf) {
+  const std::string lf = test::readFile(test::worldsDir() / "rotate.w");
+  std::string crlf;
+  for (char c : lf) {
+    if (c == '\n') crlf += '\r';
+    crlf += c;
+  }
+  const World a = parseWorld(lf, "lf"), b = parseWorld(crlf, "crlf");
+  EXPECT_EQ(formatWorld(a), formatWorld(b));
+}
+
+TEST(ReferenceWorlds, IntegratorNamesAreCaseInsensitive) {
+  const std::string text = test::readFile(test::worldsDir() / "moveLeft.w");
+  for (const char* name : {"EULER", "euler", "Euler", "rk4", "Symplectic"}) {
+    const World w = parseWorld(name + text.substr(3), "named");
+    EXPECT_EQ(w.integrator, *parseIntegratorName(name));
+  }
+}
+
+// A valid world small enough to edit by line: plane on line 6, a 2^3 field on lines 8-15,
+// positions from line 16, velocities from line 528.
+std::vector<std::string> validLines() {
+  SceneSpec spec;
+  spec.fieldResolution = 2;
+  std::istringstream in(formatWorld(buildWorld(spec)));
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+std::string join(const std::vector<std::string>& lines) {
+  std::string text;
+  for (const std::string& l : lines) text += l + "\n";
+  return text;
+}
+
+struct BadInput {
+  friend void PrintTo(const BadInput& b, std::ostream* os) { *os << b.name; }
+  std::string name;
+  int line;             // 1-based line to replace; 0: use `text` as the whole file
+  std::string replace;  // its new text ("" with drop > 0: remove lines)
+  int drop = 0;         // lines to remove from the end
+  std::string append;   // text added at the end
+  int expectedLine;
+  std::string expectedToken;
+  std::string expectedMessage;
+};
+
+class BadWorld : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(BadWorld, IsRefusedNamingFileLineAndToken) {
+  const BadInput& b = GetParam();
+  std::vector<std::string> lines = validLines();
+  if (b.line > 0) lines[b.line - 1] = b.replace;
+  lines.resize(lines.size() - b.drop);
+  std::string text = b.line == 0 && b.drop == 0 && b.append.empty() ? b.replace : join(lines);
+  text += b.append;
+  try {
+    (void)parseWorld(text, "bad.w");
+    FAIL() << "accepted";
+  } catch (const WorldFileError& e) {
+    EXPECT_EQ(e.file(), "bad.w");
+    EXPECT_EQ(e.line(), b.expectedLine) << e.what();
+    EXPECT_EQ(e.token(), b.expectedToken) << e.what();
+    EXPECT_NE(std::string(e.what()).find(b.expectedMessage), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind("bad.w:" + std::to_string(b.expectedLine) + ": ", 0),
+              0u)
+        << e.what();
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    EveryErrorClass, BadWorld,
+    ::testing::Values(
+        BadInput{"EmptyFile", 0, "", 0, "", 1, "<end of file>", "empty file"},
+        BadInput{"UnknownIntegrator", 1, "Verlet", 0, "", 1, "Verlet", "unknown integrator"},
+        BadInput{"ZeroDt", 2, "0 1", 0, "", 2, "0", "must be positive"},
+        BadInput{"NegativeDt", 2, "-0.001 1", 0, "", 2, "-0.001", "must be positive"},
+        BadInput{"NanDt", 2, "nan 1", 0, "", 2, "nan", "must be finite"},
+        BadInput{"NonNumericDt", 2, "fast 1", 0, "", 2, "fast", "expected a number"},
+        BadInput{"ZeroStepsPerFrame", 2, "0.001 0", 0, "", 2, "0", "at least 1"},
+        BadInput{"FractionalStepsPerFrame", 2, "0.001 1.5", 0, "", 2, "1.5",
+                 "expected an integer"},
+        BadInput{"NegativeConstant", 3, "200 -0.25 400 0.25", 0, "", 3, "-0.25",
+                 "must not be negative"},
+        BadInput{"ZeroMass", 4, "0", 0, "", 4, "0", "must be positive"},
+        BadInput{"InfiniteMass", 4, "inf", 0, "", 4, "inf", "must be finite"},
+        BadInput{"OverflowingMass", 4, "1e999", 0, "", 4, "1e999", "out of range"},
+        BadInput{"ZeroPlaneNormal", 6, "0 0 0 2", 0, "", 6, "0", "normal (a,b,c) is zero"},
+        BadInput{"FieldResolutionOne", 7, "1", 0, "", 7, "1", "force-field resolution"},
+        BadInput{"NegativeFieldResolution", 7, "-3", 0, "", 7, "-3", "force-field resolution"},
+        BadInput{"HugeFieldResolution", 7, "100000", 0, "", 7, "100000",
+                 "force-field resolution"},
+        BadInput{"FieldLargerThanTheFile", 7, "100", 0, "", 7, "100", "too short"},
+        BadInput{"NonNumericPosition", 16, "0 abc 0", 0, "", 16, "abc", "expected a number"},
+        BadInput{"InfinitePosition", 20, "0 0 -inf", 0, "", 20, "-inf", "must be finite"},
+        BadInput{"TruncatedVelocities", 0, "", 10, "", 1029, "<end of file>",
+                 "truncated: 502 of 512 velocities"},
+        BadInput{"TruncatedPositions", 0, "", 600, "", 439, "<end of file>",
+                 "truncated: 424 of 512 positions"},
+        BadInput{"TrailingNumbers", 0, "", 0, "1 2 3\n", 1040, "1",
+                 "unknown trailing content"},
+        BadInput{"UnknownKeyword", 0, "", 0, "wobble 3\n", 1040, "wobble",
+                 "unknown trailing content"},
+        BadInput{"CubeResolutionOne", 0, "", 0, "cube 1\n", 1040, "1", "cube resolution"},
+        BadInput{"CubeResolutionMismatch", 0, "", 0, "cube 3\n", 70, "0",
+                 "unknown trailing content"},
+        BadInput{"NegativeSphereRadius", 0, "", 0, "sphere 0 0 0 -1\n", 1040, "-1",
+                 "must be positive"},
+        BadInput{"CubeTwice", 0, "", 0, "cube 8\ncube 8\n", 1041, "cube", "given twice"}),
+    [](const auto& param_info) { return param_info.param.name; });
+
+TEST(WorldReader, RefusesAHugeCubeBeforeAllocating) {
+  ReaderLimits limits;
+  limits.maxCubeResolution = 16;
+  std::vector<std::string> lines = validLines();
+  lines.push_back("cube 17");
+  EXPECT_THROW((void)parseWorld(join(lines), "big.w", limits), WorldFileError);
+}
+
+TEST(WorldReader, ReportsAMissingFile) {
+  try {
+    (void)readWorld("/nonexistent/dir/world.w");
+    FAIL();
+  } catch (const WorldFileError& e) {
+    EXPECT_EQ(e.line(), 0);
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/world.w"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("cannot open"), std::string::npos);
+  }
+}
+
+TEST(WorldReader, ReportsADirectory) {
+  EXPECT_THROW((void)readWorld(test::worldsDir()), WorldFileError);
+}
+
+TEST(WorldReader, ReadsPlaneFlagsOtherThanOneAsNoPlane) {
+  std::vector<std::string> lines = validLines();
+  lines[4] = "7";
+  lines.erase(lines.begin() + 5);  // the plane's coefficients
+  EXPECT_FALSE(parseWorld(join(lines), "flag.w").plane.has_value());
+}
+
+}  // namespace
+}  // namespace jello
