@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# The whole test suite: installs what is missing, builds (Release) and runs ctest.
+# `scripts/test.sh asan` does the same with AddressSanitizer and UndefinedBehaviorSanitizer.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+preset=${1:-release}
+scripts/install-deps.sh
+scripts/build.sh "$preset"
+ctest --preset "$preset" -j"$(nproc)"
