@@ -67,10 +67,12 @@ int main(int argc, char** argv) {
                                                   {"gravity", FieldPreset::Gravity},
                                                   {"vortex", FieldPreset::Vortex},
                                                   {"radial", FieldPreset::Radial}};
-  app.add_option("--field", spec.field,
+  std::string field = "none", pose = "skewed";
+  app.add_option("--field", field,
                  "Force field: none (zero), gravity F=(0,0,-s), vortex F=s(-y,x,0), "
                  "radial F=-s(x,y,z)")
-      ->transform(CLI::CheckedTransformer(fields, CLI::ignore_case));
+      ->check(CLI::IsMember(fields, CLI::ignore_case))
+      ->capture_default_str();
   app.add_option("--field-strength", fieldStrength,
                  "s above; default: gravity 9.81*mass N, vortex 5*mass N/m (rotate.w), "
                  "radial 25*mass N/m");
@@ -83,10 +85,11 @@ int main(int argc, char** argv) {
                                                 {"stretched", PosePreset::Stretched},
                                                 {"rotated", PosePreset::Rotated},
                                                 {"translated", PosePreset::Translated}};
-  app.add_option("--pose", spec.pose,
-                 "Initial pose: rest, skewed (far corner out by one spacing; default), "
-                 "stretched, rotated, translated")
-      ->transform(CLI::CheckedTransformer(poses, CLI::ignore_case));
+  app.add_option("--pose", pose,
+                 "Initial pose: rest, skewed (far corner out by one spacing), stretched, "
+                 "rotated, translated")
+      ->check(CLI::IsMember(poses, CLI::ignore_case))
+      ->capture_default_str();
   app.add_option("--stretch", spec.stretch, "Stretch factor along x for --pose stretched")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
@@ -123,6 +126,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   spec.integrator = *kind;
+  field = CLI::detail::to_lower(field);
+  spec.field = fields.at(field);
+  spec.pose = poses.at(CLI::detail::to_lower(pose));
   if (noPlane) spec.plane.reset();
   if (!plane.empty()) spec.plane = jello::Plane{plane[0], plane[1], plane[2], plane[3]};
   if (!sphere.empty()) spec.sphere = jello::Sphere{{sphere[0], sphere[1], sphere[2]}, sphere[3]};
@@ -146,8 +152,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "jello-create-world: error: %s\n", e.what());
     return 1;
   }
-  std::printf("wrote %s (%d points%s%s%s)\n", out.c_str(), world.numPoints(),
+  std::printf("wrote %s (%d points%s%s, field %s)\n", out.c_str(), world.numPoints(),
               world.plane ? ", plane" : "", world.sphere ? ", sphere" : "",
-              world.field.resolution ? ", field" : "");
+              world.field.resolution ? (field + " at " + std::to_string(world.field.resolution) +
+                                        "^3 nodes").c_str()
+                                     : "none");
   return 0;
 }

@@ -98,3 +98,20 @@ TEST(Simulation, EveryReferenceWorldRunsATenthOfASecondWithItsOwnSettings) {
 
 }  // namespace
 }  // namespace jello
+
+namespace jello {
+namespace {
+
+TEST(Worlds, EveryWorldInTheFolderLoadsAndRunsTwoHundredStepsAtItsOwnDt) {
+  int count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(test::worldsDir())) {
+    if (entry.path().extension() != ".w") continue;
+    ++count;
+    Simulation sim(readWorld(entry.path()));
+    for (int i = 0; i < 200; ++i) ASSERT_TRUE(sim.step().ok) << entry.path() << " step " << i;
+  }
+  EXPECT_GE(count, 11);  // the six reference worlds and our own scenes
+}
+
+}  // namespace
+}  // namespace jello

@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Regenerates the project's own scenes in worlds/ with jello-create-world (the six reference
+# worlds there are copies and are never regenerated). Run after scripts/build.sh.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+create=build/release/experiments/jello-create-world
+
+# Stiff free cubes for the stability studies: no plane, no field, undamped, far corner pulled.
+$create -o worlds/stiff-k1e4.w --k-elastic 1e4 --d-elastic 0 --no-plane --field-resolution 0 \
+  --velocity 0 0 0 --dt 1e-4
+$create -o worlds/stiff-k1e5.w --k-elastic 1e5 --d-elastic 0 --no-plane --field-resolution 0 \
+  --velocity 0 0 0 --dt 2e-5
+# Dropped under gravity onto a sphere (the sphere extension).
+$create -o worlds/sphere-drop.w --no-plane --field gravity --field-resolution 2 --pose translated \
+  --translate -0.5 -0.5 0.2 --velocity 0 0 0 --sphere 0 0 -1.2 0.8 --dt 2e-4
+# Spinning in rotate.w's vortex, against the plane of jello.w.
+$create -o worlds/vortex-spin.w --field vortex --field-resolution 5 --pose rest --spin 20 \
+  --velocity 0 0 0 --dt 5e-4
+# The default scene with a 16^3 cube (the cube extension), for cost as N grows.
+$create -o worlds/cube16.w --cube 16 --field-resolution 0 --dt 2.5e-4
