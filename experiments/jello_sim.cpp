@@ -38,6 +38,9 @@ struct Options {
   std::string out, trace, stats;
   long every = 100;
   bool quiet = false;
+  jello::SolverOptions solver;
+  std::string linearSolver = "cholmod";
+  bool noClamp = false, noStabLimDet = false;
 };
 
 nlohmann::json toJson(const Energy& e) {
@@ -89,7 +92,7 @@ int run(const Options& opt) {
       return kExitUsage;
     }
   }
-  Simulation sim(std::move(world), kind, opt.dt);
+  Simulation sim(std::move(world), kind, opt.dt, opt.solver);
   const double dt = sim.dt();
   const long total = opt.steps ? *opt.steps
                                : static_cast<long>(std::ceil(opt.time.value_or(1.0) / dt - 1e-9));
@@ -130,6 +133,8 @@ int run(const Options& opt) {
       {"energy_end", toJson(end)},
       {"diverged", diverged},
   };
+  const std::vector<jello::Statistic> solverStats = sim.integratorState().statistics();
+  for (const jello::Statistic& st : solverStats) stats["solver"][st.name] = st.value;
   if (diverged) {
     const jello::Divergence& d = *sim.divergence();
     stats["divergence"] = {{"time_s", d.time}, {"step", d.step}, {"reason", d.reason}};
@@ -149,6 +154,9 @@ int run(const Options& opt) {
                 start.contact, start.total());
     std::printf("  %-10s %12.6g %12.6g %12.6g %12.6g\n", diverged ? "last sane" : "end",
                 end.kinetic, end.spring, end.contact, end.total());
+    for (const jello::Statistic& st : solverStats) {
+      std::printf("  %-28s %.6g\n", st.name.c_str(), st.value);
+    }
   }
 
   try {
@@ -173,7 +181,8 @@ int main(int argc, char** argv) {
   Options opt;
   CLI::App app{
       "Steps a jello world headless and prints a summary: steps, simulated and wall time, "
-      "steps/s, real-time factor, energy at start and end.\n"
+      "steps/s, real-time factor, energy at start and end, and the solver's statistics. For "
+      "cvode, --dt is the output interval; CVODE chooses its own internal steps.\n"
       "Exit codes: 0 done, 1 bad world file or I/O failure, 2 bad usage, 3 diverged.",
       "jello-sim"};
   app.add_option("world", opt.world, "World file (.w)")->required();
@@ -196,11 +205,59 @@ int main(int argc, char** argv) {
       ->needs(trace);
   app.add_option("--stats", opt.stats, "Write the summary as JSON");
   app.add_flag("--quiet,-q", opt.quiet, "Print nothing but errors");
+
+  auto& implicit = opt.solver.implicit;
+  auto& cvode = opt.solver.cvode;
+  const char* implicitGroup = "Implicit solvers (implicit, cvode)";
+  app.add_option("--linear-solver", opt.linearSolver,
+                 "cholmod (supernodal LLT), ldlt, or cg (Jacobi-preconditioned, warm-started)")
+      ->check(CLI::IsMember({"cholmod", "ldlt", "cg"}))
+      ->capture_default_str()
+      ->group(implicitGroup);
+  app.add_flag("--no-clamp", opt.noClamp,
+               "Do not clamp compressed springs' Jacobians (the system may be indefinite)")
+      ->group(implicitGroup);
+  app.add_option("--cg-tol", implicit.cgTolerance, "Relative residual of CG solves")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group(implicitGroup);
+  app.add_option("--newton-iters", implicit.newtonIterations,
+                 "implicit: Newton iterations per step (1 = linearized Baraff-Witkin step)")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str()
+      ->group(implicitGroup);
+  app.add_option("--newton-tol", implicit.newtonTolerance,
+                 "implicit: relative residual that ends the Newton iterations")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group(implicitGroup);
+  app.add_option("--rtol", cvode.rtol, "cvode: relative tolerance")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group(implicitGroup);
+  app.add_option("--atol", cvode.atol, "cvode: absolute tolerance (default 1e-3 * rtol)")
+      ->check(CLI::PositiveNumber)
+      ->group(implicitGroup);
+  app.add_option("--max-order", cvode.maxOrder, "cvode: largest BDF order")
+      ->check(CLI::Range(1, 5))
+      ->capture_default_str()
+      ->group(implicitGroup);
+  app.add_flag("--no-stab-lim-det", opt.noStabLimDet,
+               "cvode: switch off BDF stability-limit detection")
+      ->group(implicitGroup);
+  app.add_option("--max-step", cvode.maxStep, "cvode: largest internal step, s (default none)")
+      ->check(CLI::PositiveNumber)
+      ->group(implicitGroup);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : kExitUsage;
   }
+  const auto linear = *jello::parseLinearSolver(opt.linearSolver);
+  opt.solver.implicit.linearSolver = opt.solver.cvode.linearSolver = linear;
+  opt.solver.implicit.clampCompression = opt.solver.cvode.clampCompression = !opt.noClamp;
+  opt.solver.cvode.cgTolerance = opt.solver.implicit.cgTolerance;
+  opt.solver.cvode.stabilityLimitDetection = !opt.noStabLimDet;
   return run(opt);
 }

@@ -5,20 +5,20 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "integrator_name.h"
 #include "model.h"
+#include "solver_options.h"
 #include "state.h"
+#include "step_result.h"
 
 namespace jello {
 
-// Numerical failure is a result the caller must look at, never an exception or a silent NaN.
-struct [[nodiscard]] StepResult {
-  bool ok = true;
-  std::string message;  // why, when !ok
-
-  static StepResult success() { return {}; }
-  static StepResult failure(std::string why) { return {false, std::move(why)}; }
+// A named figure an integrator reports about its work (solver statistics, timings).
+struct Statistic {
+  std::string name;  // snake_case with its unit, e.g. "factor_time_s"
+  double value;
 };
 
 class Integrator {
@@ -27,8 +27,9 @@ class Integrator {
   virtual IntegratorKind kind() const = 0;
   // Advances state.x, state.v and state.t by h seconds.
   virtual StepResult step(const Model& model, State& state, double h) = 0;
+  virtual std::vector<Statistic> statistics() const { return {}; }
 };
 
-std::unique_ptr<Integrator> makeIntegrator(IntegratorKind kind);
+std::unique_ptr<Integrator> makeIntegrator(IntegratorKind kind, const SolverOptions& options = {});
 
 }  // namespace jello

@@ -27,11 +27,12 @@ std::string Divergence::describe() const {
 }
 
 Simulation::Simulation(World world, std::optional<IntegratorKind> integrator,
-                       std::optional<double> dt)
+                       std::optional<double> dt, SolverOptions options)
     : world_(std::move(world)),
       model_(world_),
       state_(initialState(world_)),
-      integrator_(makeIntegrator(integrator.value_or(world_.integrator))),
+      options_(options),
+      integrator_(makeIntegrator(integrator.value_or(world_.integrator), options_)),
       dt_(dt.value_or(world_.dt)) {}
 
 StepResult Simulation::step() {
@@ -48,7 +49,7 @@ StepResult Simulation::step() {
 }
 
 void Simulation::setIntegrator(IntegratorKind kind) {
-  if (kind != integrator_->kind()) integrator_ = makeIntegrator(kind);
+  if (kind != integrator_->kind()) integrator_ = makeIntegrator(kind, options_);
 }
 
 void Simulation::setTimeStep(double dt) { dt_ = dt; }

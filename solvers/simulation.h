@@ -34,7 +34,7 @@ class Simulation {
  public:
   // The world's own integrator and dt unless overridden.
   explicit Simulation(World world, std::optional<IntegratorKind> integrator = std::nullopt,
-                      std::optional<double> dt = std::nullopt);
+                      std::optional<double> dt = std::nullopt, SolverOptions options = {});
 
   // One step of dt. On failure (divergence, or a solver's own failure) the state keeps the last
   // sane values and every further call fails the same way.
@@ -46,6 +46,7 @@ class Simulation {
 
   const World& world() const { return world_; }
   const Model& model() const { return model_; }
+  const Integrator& integratorState() const { return *integrator_; }
   const State& state() const { return state_; }
   IntegratorKind integrator() const { return integrator_->kind(); }
   double dt() const { return dt_; }
@@ -60,6 +61,7 @@ class Simulation {
   Model model_;
   State state_;
   State previous_;
+  SolverOptions options_;
   std::unique_ptr<Integrator> integrator_;
   double dt_;
   long steps_ = 0;

@@ -21,6 +21,7 @@ struct ContactConstants {
 class WallContact {
  public:
   explicit WallContact(ContactConstants k) : k_(k) {}
+  const ContactConstants& constants() const { return k_; }
   // True when every point is inside the box, so there is nothing to do.
   static bool allInside(const double* x, int n);
   void accumulate(const double* x, const double* v, double* f, int n) const;
@@ -37,6 +38,7 @@ class PlaneContact {
   double energy(const double* x, int n) const;
   const Vec3& normal() const { return normal_; }  // unit, into free space
   double offset() const { return offset_; }       // signed distance = normal.x + offset
+  const ContactConstants& constants() const { return k_; }
 
  private:
   Vec3 normal_;
@@ -47,6 +49,8 @@ class PlaneContact {
 class SphereContact {
  public:
   SphereContact(const Sphere& sphere, ContactConstants k) : sphere_(sphere), k_(k) {}
+  const Sphere& sphere() const { return sphere_; }
+  const ContactConstants& constants() const { return k_; }
   void accumulate(const double* x, const double* v, double* f, int n) const;
   double energy(const double* x, int n) const;
 

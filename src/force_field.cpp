@@ -48,6 +48,38 @@ Vec3 FieldForces::sample(const Vec3& position) const {
   return lerp(lerp(c00, c01, fy), lerp(c10, c11, fy), fx);
 }
 
+void FieldForces::gradient(const Vec3& position, double out[3][3]) const {
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) out[a][b] = 0.0;
+  if (uniform_) return;
+  const int r = field_.resolution;
+  const double p[3] = {position.x, position.y, position.z};
+  int cell[3];
+  double frac[3];
+  for (int b = 0; b < 3; ++b) locate(p[b], r, cell[b], frac[b]);
+  const double perMetre = (r - 1) / (2.0 * kBoxHalfSize);  // d(frac)/d(position)
+  for (int di = 0; di < 2; ++di)
+    for (int dj = 0; dj < 2; ++dj)
+      for (int dk = 0; dk < 2; ++dk) {
+        const int corner[3] = {di, dj, dk};
+        double w[3], dw[3];  // 1-D weights and their derivatives per axis
+        for (int b = 0; b < 3; ++b) {
+          w[b] = corner[b] ? frac[b] : 1.0 - frac[b];
+          const bool clamped = p[b] < -kBoxHalfSize || p[b] > kBoxHalfSize;
+          dw[b] = clamped ? 0.0 : (corner[b] ? perMetre : -perMetre);
+        }
+        const Vec3& F =
+            field_.forces[static_cast<std::size_t>(((cell[0] + di) * r + (cell[1] + dj)) * r +
+                                                   (cell[2] + dk))];
+        const double grad[3] = {dw[0] * w[1] * w[2], w[0] * dw[1] * w[2], w[0] * w[1] * dw[2]};
+        for (int b = 0; b < 3; ++b) {
+          out[0][b] += F.x * grad[b];
+          out[1][b] += F.y * grad[b];
+          out[2][b] += F.z * grad[b];
+        }
+      }
+}
+
 void FieldForces::accumulate(const double* x, double* f, int n) const {
   if (uniform_) {
     for (int p = 0; p < n; ++p) {

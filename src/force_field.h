@@ -14,6 +14,9 @@ class FieldForces {
   explicit FieldForces(ForceField field);
 
   Vec3 sample(const Vec3& position) const;  // N
+  // dF_a/dx_b (N/m), row a, column b: the derivative of the trilinear interpolant inside the
+  // cell, zero along an axis where the position is clamped. Not symmetric in general.
+  void gradient(const Vec3& position, double out[3][3]) const;
   // Adds the field force at each of the n points (component-major x) to f.
   void accumulate(const double* x, double* f, int n) const;
 

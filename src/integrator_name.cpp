@@ -13,14 +13,17 @@ struct NameEntry {
   std::string_view fileName;
 };
 
-constexpr std::array<NameEntry, 3> kNames{{
+constexpr std::array<NameEntry, 5> kNames{{
     {IntegratorKind::Euler, "euler", "Euler"},
     {IntegratorKind::Symplectic, "symplectic", "symplectic"},
     {IntegratorKind::RK4, "rk4", "RK4"},
+    {IntegratorKind::Implicit, "implicit", "implicit"},
+    {IntegratorKind::Cvode, "cvode", "cvode"},
 }};
 
 constexpr std::array<IntegratorKind, kNames.size()> kKinds{
-    IntegratorKind::Euler, IntegratorKind::Symplectic, IntegratorKind::RK4};
+    IntegratorKind::Euler, IntegratorKind::Symplectic, IntegratorKind::RK4,
+    IntegratorKind::Implicit, IntegratorKind::Cvode};
 
 bool equalsIgnoreCase(std::string_view a, std::string_view b) {
   return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char p, char q) {

@@ -1,5 +1,6 @@
 #include "model.h"
 
+#include <algorithm>
 #include <cassert>
 
 namespace jello {
@@ -29,37 +30,49 @@ Model::Model(ModelSpec spec)
   }
 }
 
-void Model::forces(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& f) const {
-  assert(x.size() == 3 * n_ && v.size() == 3 * n_);
-  f.setZero(3 * n_);
-  springs_.accumulate(x.data(), v.data(), f.data());
+void Model::forces(const double* x, const double* v, double* f) const {
+  std::fill(f, f + 3 * n_, 0.0);
+  springs_.accumulate(x, v, f);
   ++counts_.springs;
   if (walls_) {
-    if (WallContact::allInside(x.data(), n_)) {
+    if (WallContact::allInside(x, n_)) {
       ++counts_.wallsSkipped;
     } else {
-      walls_->accumulate(x.data(), v.data(), f.data(), n_);
+      walls_->accumulate(x, v, f, n_);
       ++counts_.walls;
     }
   }
   if (plane_) {
-    plane_->accumulate(x.data(), v.data(), f.data(), n_);
+    plane_->accumulate(x, v, f, n_);
     ++counts_.plane;
   }
   if (sphere_) {
-    sphere_->accumulate(x.data(), v.data(), f.data(), n_);
+    sphere_->accumulate(x, v, f, n_);
     ++counts_.sphere;
   }
   if (field_) {
-    field_->accumulate(x.data(), f.data(), n_);
+    field_->accumulate(x, f, n_);
     ++counts_.field;
   }
 }
 
+void Model::acceleration(const double* x, const double* v, double* a) const {
+  forces(x, v, a);
+  const double inv = 1.0 / mass_;
+  for (int i = 0; i < 3 * n_; ++i) a[i] *= inv;
+}
+
+void Model::forces(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& f) const {
+  assert(x.size() == 3 * n_ && v.size() == 3 * n_);
+  f.resize(3 * n_);
+  forces(x.data(), v.data(), f.data());
+}
+
 void Model::acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                          Eigen::VectorXd& a) const {
-  forces(x, v, a);
-  a *= 1.0 / mass_;
+  assert(x.size() == 3 * n_ && v.size() == 3 * n_);
+  a.resize(3 * n_);
+  acceleration(x.data(), v.data(), a.data());
 }
 
 Energy Model::energy(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const {

@@ -58,9 +58,12 @@ class Model {
   int numPoints() const { return n_; }
   double mass() const { return mass_; }
 
-  // f = total force (N) at state (x, v); all vectors 3n, component-major. f is resized.
-  void forces(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& f) const;
+  // f = total force (N) at state (x, v); all arrays 3n, component-major.
+  void forces(const double* x, const double* v, double* f) const;
   // a = f / m (m/s^2).
+  void acceleration(const double* x, const double* v, double* a) const;
+  // The same on Eigen vectors; the output is resized.
+  void forces(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& f) const;
   void acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                     Eigen::VectorXd& a) const;
 
@@ -68,6 +71,11 @@ class Model {
   Energy energy(const State& s) const { return energy(s.x, s.v); }
 
   const SpringForces& springs() const { return springs_; }
+  // The effects, for Jacobian assembly: empty when the scene does not have them.
+  const std::optional<WallContact>& walls() const { return walls_; }
+  const std::optional<PlaneContact>& plane() const { return plane_; }
+  const std::optional<SphereContact>& sphere() const { return sphere_; }
+  const std::optional<FieldForces>& field() const { return field_; }
   bool hasWalls() const { return walls_.has_value(); }
   bool hasPlane() const { return plane_.has_value(); }
   bool hasSphere() const { return sphere_.has_value(); }

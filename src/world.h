@@ -54,7 +54,7 @@ struct World {
   // not read it as written).
   bool usesExtensions() const {
     return cubeResolution != kDefaultCubeResolution || sphere.has_value() ||
-           integrator == IntegratorKind::Symplectic;
+           (integrator != IntegratorKind::Euler && integrator != IntegratorKind::RK4);
   }
 };
 

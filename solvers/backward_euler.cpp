@@ -1,0 +1,96 @@
+#include "backward_euler.h"
+
+#include <chrono>
+
+namespace jello {
+
+BackwardEuler::BackwardEuler(ImplicitOptions options)
+    : options_(options), solver_(options.linearSolver, options.cgTolerance) {}
+
+void BackwardEuler::prepare(const Model& model) {
+  if (model_ == &model) return;
+  model_ = &model;
+  jacobian_ = std::make_unique<JacobianAssembler>(model);
+  A_ = jacobian_->pattern();
+  dv_.setZero(3 * model.numPoints());
+}
+
+void BackwardEuler::assemble(const double* x, const double* v) {
+  const auto start = std::chrono::steady_clock::now();
+  jacobian_->assemble(x, v, {options_.clampCompression, false});
+  assembleSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+                          .count();
+}
+
+// Factors M - h D - h^2 K of the last assembly and solves it for rhs into dv_.
+StepResult BackwardEuler::factorAndSolve(double h, const Eigen::VectorXd& rhs) {
+  jacobian_->combine(h, h * h, A_);
+  if (StepResult r = solver_.factorize(A_); !r.ok) return r;
+  return solver_.solve(rhs, dv_);  // dv_ holds the last solution: CG's warm start
+}
+
+double BackwardEuler::residual(const Model& model, const State& s, double h) {
+  model.forces(x1_, v1_, f_);
+  g_ = model.mass() * (v1_ - s.v) - h * f_;
+  const double scale = model.mass() * (v1_ - s.v).norm() + h * f_.norm();
+  return scale > 0.0 ? g_.norm() / scale : 0.0;
+}
+
+StepResult BackwardEuler::step(const Model& model, State& s, double h) {
+  prepare(model);
+  model.forces(s.x, s.v, f_);
+  // First iteration, linearized at (x0, v0): rhs = h (f0 + h K v0).
+  assemble(s.x.data(), s.v.data());
+  rhs_.noalias() = jacobian_->K() * s.v;
+  rhs_ = h * (f_ + h * rhs_);
+  if (StepResult r = factorAndSolve(h, rhs_); !r.ok) return r;
+  v1_ = s.v + dv_;
+  x1_ = s.x + h * v1_;
+
+  int iterations = 1;
+  lastResidual_ = 0.0;
+  if (options_.newtonIterations > 1) {
+    // Newton on g(v1): (M - h D - h^2 K)(x1, v1) delta = -g.
+    for (;;) {
+      lastResidual_ = residual(model, s, h);
+      if (lastResidual_ <= options_.newtonTolerance) break;
+      if (iterations >= options_.newtonIterations) {
+        ++unconverged_;
+        break;
+      }
+      rhs_ = -g_;
+      assemble(x1_.data(), v1_.data());
+      if (StepResult r = factorAndSolve(h, rhs_); !r.ok) return r;
+      v1_ += dv_;
+      x1_ = s.x + h * v1_;
+      ++iterations;
+    }
+  }
+  lastIterations_ = iterations;
+  newtonIterations_ += iterations;
+  ++steps_;
+  s.x.swap(x1_);
+  s.v.swap(v1_);
+  s.t += h;
+  return StepResult::success();
+}
+
+std::vector<Statistic> BackwardEuler::statistics() const {
+  const LinearSolverStats& ls = solver_.stats();
+  std::vector<Statistic> stats{
+      {"newton_iterations", static_cast<double>(newtonIterations_)},
+      {"newton_unconverged_steps", static_cast<double>(unconverged_)},
+      {"compression_clamps", static_cast<double>(clampCount())},
+      {"factorizations", static_cast<double>(ls.factorizations)},
+      {"ldlt_fallbacks", static_cast<double>(ls.fallbacks)},
+      {"assemble_time_s", assembleSeconds_},
+      {"factor_time_s", ls.factorSeconds},
+      {"solve_time_s", ls.solveSeconds},
+  };
+  if (solver_.kind() == LinearSolverKind::Cg) {
+    stats.push_back({"cg_iterations", static_cast<double>(ls.cgIterations)});
+  }
+  return stats;
+}
+
+}  // namespace jello

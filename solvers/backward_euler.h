@@ -1,0 +1,51 @@
+// Backward Euler, linearized (Baraff & Witkin 1998), K = df/dx and D = df/dv at (x0, v0):
+//   (M - h D - h^2 K) dv = h (f0 + h K v0),   v1 = v0 + dv,   x1 = x0 + h v1.
+// This is the first Newton iteration of backward Euler; with newtonIterations > 1 further
+// iterations solve the exact step, the residual
+//   g(v1) = M (v1 - v0) - h f(x0 + h v1, v1)
+// driven below newtonTolerance relative to |M (v1 - v0)| + |h f|. It never blows up on a
+// linear system and removes energy: an undamped mode keeps 1/(1 + h^2 w^2) of it per step.
+// The force field is treated explicitly (its gradient is not symmetric).
+#pragma once
+
+#include <memory>
+
+#include "integrator.h"
+#include "jacobian.h"
+#include "linear_solver.h"
+
+namespace jello {
+
+class BackwardEuler final : public Integrator {
+ public:
+  explicit BackwardEuler(ImplicitOptions options = {});
+
+  IntegratorKind kind() const override { return IntegratorKind::Implicit; }
+  StepResult step(const Model& model, State& state, double h) override;
+  std::vector<Statistic> statistics() const override;
+
+  // Relative residual after the last step's final Newton iteration (0 for one iteration).
+  double lastResidual() const { return lastResidual_; }
+  int lastIterations() const { return lastIterations_; }
+  const SpdSolver& linearSolver() const { return solver_; }
+  long clampCount() const { return jacobian_ ? jacobian_->totalClampCount() : 0; }
+
+ private:
+  void prepare(const Model& model);
+  double residual(const Model& model, const State& s, double h);
+  void assemble(const double* x, const double* v);
+  StepResult factorAndSolve(double h, const Eigen::VectorXd& rhs);
+
+  ImplicitOptions options_;
+  const Model* model_ = nullptr;
+  std::unique_ptr<JacobianAssembler> jacobian_;
+  SparseMatrix A_;
+  SpdSolver solver_;
+  Eigen::VectorXd f_, rhs_, dv_, v1_, x1_, g_;
+  double lastResidual_ = 0.0;
+  int lastIterations_ = 0;
+  long steps_ = 0, newtonIterations_ = 0, unconverged_ = 0;
+  double assembleSeconds_ = 0.0;
+};
+
+}  // namespace jello

@@ -1,0 +1,57 @@
+// SUNDIALS CVODE (6.4), variable-order BDF with Newton iterations, on y = (x, v):
+//   y' = (v, M^-1 f(x, v)),   Newton matrix I - g J,   J = [[0, I], [M^-1 K, M^-1 D]].
+// Its linear systems (I - g J)(a, b) = (r1, r2) are solved through the reduced, symmetric
+// 3n system (physics.md)
+//   (M - g D - g^2 K) b = M r2 + g K r1,   a = r1 + g b,
+// with the same Jacobian assembly and CHOLMOD (or CG) machinery as backward Euler, inside a
+// custom linear solver of DIRECT type, so CVODE keeps its own heuristics for when to refresh
+// the Jacobian and refactor, and its correction for a changed g. One step() call advances the
+// state to t + h (an output interval), CVODE choosing its own internal steps.
+#pragma once
+
+#include <memory>
+
+#include "integrator.h"
+#include "jacobian.h"
+#include "linear_solver.h"
+#include "sundials_handles.h"
+
+namespace jello {
+
+class CvodeIntegrator final : public Integrator {
+ public:
+  explicit CvodeIntegrator(CvodeOptions options = {});
+  ~CvodeIntegrator() override;
+
+  IntegratorKind kind() const override { return IntegratorKind::Cvode; }
+  StepResult step(const Model& model, State& state, double h) override;
+  std::vector<Statistic> statistics() const override;
+
+  // The callbacks' work (public for the C trampolines in the .cpp).
+  int rightHandSide(const double* y, double* ydot);
+  int linearSystem(const double* y, bool jacobianOk, bool* jacobianCurrent, double gamma);
+  int setupSolver();
+  int solve(const double* b, double* x);
+
+ private:
+  StepResult start(const Model& model, const State& state);
+  bool continues(const Model& model, const State& state) const;
+
+  CvodeOptions options_;
+  const Model* model_ = nullptr;
+  int n3_ = 0;  // 3n
+  sundials::Context context_;
+  sundials::Vector y_;
+  sundials::Matrix matrix_;
+  sundials::LinearSolver linearSolver_;
+  sundials::CvodeMemory cvode_;
+  std::unique_ptr<JacobianAssembler> jacobian_;
+  SparseMatrix A_;
+  std::unique_ptr<SpdSolver> solver_;
+  double gamma_ = 0.0;  // of the matrix last formed
+  bool assembled_ = false;
+  Eigen::VectorXd rhs_, b_;
+  double t_ = 0.0;  // CVODE's time, to notice a state changed from outside
+};
+
+}  // namespace jello

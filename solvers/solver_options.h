@@ -1,0 +1,33 @@
+// Settings of the implicit integrators, as plain structs (README "Implicit solvers").
+#pragma once
+
+#include "linear_solver.h"
+
+namespace jello {
+
+struct ImplicitOptions {
+  LinearSolverKind linearSolver = LinearSolverKind::Cholmod;
+  int newtonIterations = 1;        // 1: the linearized step of Baraff & Witkin
+  double newtonTolerance = 1e-8;   // relative residual that ends the Newton iterations
+  bool clampCompression = true;    // project each spring's Hessian onto semidefinite matrices
+  double cgTolerance = 1e-6;       // relative residual of the CG solves
+};
+
+struct CvodeOptions {
+  double rtol = 1e-6;
+  double atol = 0.0;               // 0: 1e-3 * rtol (positions in m, velocities in m/s)
+  int maxOrder = 5;                // BDF order limit, 1..5 (3..5 are not A-stable)
+  bool stabilityLimitDetection = true;
+  double maxStep = 0.0;            // s, 0: no limit
+  long maxStepsPerCall = 1000000;  // internal steps CVODE may take to reach one output time
+  LinearSolverKind linearSolver = LinearSolverKind::Cholmod;
+  bool clampCompression = true;
+  double cgTolerance = 1e-6;
+};
+
+struct SolverOptions {
+  ImplicitOptions implicit;
+  CvodeOptions cvode;
+};
+
+}  // namespace jello
