@@ -50,6 +50,15 @@ Vec3 fieldAt(FieldPreset preset, double s, const Vec3& x) {
 
 }  // namespace
 
+SceneSpec stiffCube(double k) {
+  SceneSpec spec;
+  spec.kElastic = k;
+  spec.plane.reset();
+  spec.fieldResolution = 0;
+  spec.velocity = {};
+  return spec;
+}
+
 double defaultFieldStrength(FieldPreset preset, double mass) {
   switch (preset) {
     case FieldPreset::None:

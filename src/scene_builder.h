@@ -48,6 +48,11 @@ struct SceneSpec {
 // The defaults above are the original course creator's: SceneSpec{} builds createWorld's jello.w.
 World buildWorld(const SceneSpec& spec);
 
+// A stiff cube for stability studies: spring stiffness k (N/m), the reference worlds' damping
+// 0.25 N*s/m, far corner pulled out by one spacing, at rest, no plane, no field: nothing but
+// its own springs (and the walls, never reached).
+SceneSpec stiffCube(double k);
+
 // Default strength of a field preset (N): the value rotate.w / gravity.w use, scaled by mass.
 double defaultFieldStrength(FieldPreset preset, double mass);
 

@@ -1,0 +1,151 @@
+// Backward Euler: its exact energy loss, order of convergence, Newton residual, linear solvers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "backward_euler.h"
+#include "explicit_integrators.h"
+#include "scene_builder.h"
+#include "test_support.h"
+
+namespace jello {
+namespace {
+
+TEST(BackwardEuler, UndampedLinearSpringKeepsOneOverOnePlusH2W2OfItsEnergyPerStep) {
+  // Zero rest length: the force is exactly linear, and the relative motion of the two points
+  // is an undamped oscillator with w = sqrt(2k/m).
+  const double k = 2.0, m = 0.01;
+  const Model model(test::singleSpring(k, 0.0, 0.0, m));
+  State s;
+  s.x.resize(6);
+  s.v.resize(6);
+  State::set(s.x, 0, {-0.3, 0.2, 0.1});
+  State::set(s.x, 1, {0.3, -0.2, -0.1});
+  State::set(s.v, 0, {0.5, 1.0, -2.0});
+  State::set(s.v, 1, {-0.5, -1.0, 2.0});
+  auto energy = [&](const State& st) {
+    const Vec3 d = st.position(1) - st.position(0);
+    return 0.5 * m * st.v.squaredNorm() + 0.5 * k * dot(d, d);
+  };
+  const double w = std::sqrt(2 * k / m);
+  for (double y : {0.1, 1.0, 10.0}) {
+    BackwardEuler be;
+    const double h = y / w;
+    for (int i = 0; i < 10; ++i) {
+      const double before = energy(s);
+      ASSERT_TRUE(be.step(model, s, h).ok);
+      EXPECT_NEAR(energy(s) / before, 1.0 / (1.0 + y * y), 1e-10) << "y " << y << " step " << i;
+    }
+  }
+}
+
+// A 4^3 free cube (jello.w's pose and motion resampled, no walls, no plane): small systems.
+struct SmallCube {
+  World world = resampleCube(test::loadWorld("jello.w"), 4);
+  Model model{test::freeCube(world)};
+};
+
+Eigen::VectorXd positionsAt(const SmallCube& cube, Integrator& method, double h, double T) {
+  State s = initialState(cube.world);
+  const long steps = std::lround(T / h);
+  for (long i = 0; i < steps; ++i) EXPECT_TRUE(method.step(cube.model, s, h).ok);
+  return s.x;
+}
+
+TEST(BackwardEuler, ConvergesWithOrderOneTowardRK4) {
+  const SmallCube cube;
+  RungeKutta4 rk4;
+  const Eigen::VectorXd ref = positionsAt(cube, rk4, 2.5e-6, 0.02);
+  double errors[3];
+  const double steps[3] = {1e-4, 5e-5, 2.5e-5};  // h w_max from 0.13 down: asymptotic
+  for (int i = 0; i < 3; ++i) {
+    BackwardEuler be;
+    errors[i] = (positionsAt(cube, be, steps[i], 0.02) - ref).cwiseAbs().maxCoeff();
+  }
+  EXPECT_NEAR(std::log2(errors[0] / errors[1]), 1.0, 0.15);
+  EXPECT_NEAR(std::log2(errors[1] / errors[2]), 1.0, 0.1);
+}
+
+// Runs 20 Newton-iterated steps and checks the implicit equations
+//   x1 = x0 + h v1,   M (v1 - v0) = h f(x1, v1)
+// independently of the integrator's own residual. Returns the most iterations a step needed.
+int expectExactBackwardEulerSteps(const SmallCube& cube, double tolerance) {
+  ImplicitOptions options;
+  options.newtonIterations = 30;
+  options.newtonTolerance = tolerance;
+  options.clampCompression = false;  // the exact spring Jacobian
+  BackwardEuler be(options);
+  State s = initialState(cube.world);
+  const double h = 2e-3;
+  int most = 0;
+  for (int i = 0; i < 20; ++i) {
+    const State before = s;
+    EXPECT_TRUE(be.step(cube.model, s, h).ok);
+    EXPECT_LE(be.lastResidual(), tolerance) << "step " << i;
+    most = std::max(most, be.lastIterations());
+    Eigen::VectorXd f;
+    cube.model.forces(s.x, s.v, f);
+    const Eigen::VectorXd g = cube.model.mass() * (s.v - before.v) - h * f;
+    EXPECT_LE(g.norm(), 2 * tolerance * (cube.model.mass() * (s.v - before.v).norm() +
+                                         h * f.norm()));
+    EXPECT_LE((s.x - before.x - h * s.v).cwiseAbs().maxCoeff(), 1e-15);
+  }
+  return most;
+}
+
+TEST(BackwardEuler, NewtonConvergesQuadraticallyWithTheExactJacobian) {
+  // Without damping the assembled K is the exact Jacobian: the linearized first step leaves a
+  // residual near 1e-2, and each iteration squares it, down to 1e-10 within 4 iterations.
+  SmallCube cube;
+  cube.world.dElastic = 0.0;
+  cube.model = Model(test::freeCube(cube.world));
+  EXPECT_LE(expectExactBackwardEulerSteps(cube, 1e-10), 4);
+}
+
+TEST(BackwardEuler, NewtonDrivesTheResidualBelowTheToleranceWithDamping) {
+  // Spring damping's x-derivative is left out of the matrix, so convergence is linear (about
+  // a factor 16 per iteration on this cube) and ends at the tolerance.
+  const SmallCube cube;
+  EXPECT_LE(expectExactBackwardEulerSteps(cube, 1e-8), 10);
+}
+
+TEST(BackwardEuler, TheThreeLinearSolversTakeTheSameStep) {
+  const SmallCube cube;
+  State ref = initialState(cube.world);
+  BackwardEuler cholmod;
+  ASSERT_TRUE(cholmod.step(cube.model, ref, 0.01).ok);
+  for (LinearSolverKind kind : {LinearSolverKind::Ldlt, LinearSolverKind::Cg}) {
+    ImplicitOptions options;
+    options.linearSolver = kind;
+    options.cgTolerance = 1e-12;
+    BackwardEuler be(options);
+    State s = initialState(cube.world);
+    ASSERT_TRUE(be.step(cube.model, s, 0.01).ok);
+    EXPECT_LT((s.v - ref.v).cwiseAbs().maxCoeff(), 1e-8 * ref.v.cwiseAbs().maxCoeff())
+        << linearSolverName(kind);
+  }
+}
+
+TEST(BackwardEuler, FallsBackToLdltWhenTheUnclampedSystemIsIndefinite) {
+  // Every spring at half its rest length, k = 10^4, h = 0.01: with the clamp off,
+  // M - h^2 K has negative directions and the LLT fails.
+  World w = buildWorld(stiffCube(1e4));
+  for (Vec3& x : w.positions) x = Vec3{0.5, 0.5, 0.5} + (x - Vec3{0.5, 0.5, 0.5}) * 0.5;
+  w.positions.back() = Vec3{0.5, 0.5, 0.5} + Vec3{0.25, 0.25, 0.25};
+  const Model model(w);
+  ImplicitOptions options;
+  options.clampCompression = false;
+  BackwardEuler be(options);
+  State s = initialState(w);
+  const StepResult r = be.step(model, s, 0.01);
+  EXPECT_EQ(be.linearSolver().stats().fallbacks, 1);
+  // Either a checked LDLT solution or a clear failure; never a silent NaN.
+  if (r.ok) {
+    EXPECT_TRUE(s.x.allFinite() && s.v.allFinite());
+  } else {
+    EXPECT_FALSE(r.message.empty());
+  }
+}
+
+}  // namespace
+}  // namespace jello

@@ -1,0 +1,211 @@
+// Assembled Jacobians against central differences of the forces, effect by effect.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <random>
+
+#include "jacobian.h"
+#include "scene_builder.h"
+#include "test_support.h"
+
+namespace jello {
+namespace {
+
+// Central differences of the model's total force with respect to x (wrtV = false) or v.
+Eigen::MatrixXd finiteDifferences(const Model& model, const State& s, bool wrtV) {
+  const Eigen::Index n3 = s.x.size();
+  Eigen::MatrixXd J(n3, n3);
+  Eigen::VectorXd fp, fm;
+  const double h = 1e-6;
+  for (Eigen::Index j = 0; j < n3; ++j) {
+    State plus = s, minus = s;
+    (wrtV ? plus.v : plus.x)[j] += h;
+    (wrtV ? minus.v : minus.x)[j] -= h;
+    model.forces(plus.x, plus.v, fp);
+    model.forces(minus.x, minus.v, fm);
+    J.col(j) = (fp - fm) / (2 * h);
+  }
+  return J;
+}
+
+double relativeError(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff();
+}
+
+struct Assembled {
+  Eigen::MatrixXd K, D;
+  long clamps;
+};
+
+Assembled assemble(const Model& model, const State& s, JacobianOptions options) {
+  JacobianAssembler jac(model);
+  jac.assemble(s.x.data(), s.v.data(), options);
+  return {Eigen::MatrixXd(jac.K()), Eigen::MatrixXd(jac.D()), jac.lastClampCount()};
+}
+
+// Two points on one spring of rest length 0.3, at the given length, moving apart and sideways.
+State twoPoints(double length) {
+  State s;
+  s.x.setZero(6);
+  s.v.setZero(6);
+  State::set(s.x, 0, {0.1, -0.2, 0.05});
+  State::set(s.x, 1, Vec3{0.1, -0.2, 0.05} + Vec3{0.6, 0.3, -0.2} * (length / norm({0.6, 0.3, -0.2})));
+  State::set(s.v, 0, {1.0, 0.0, 0.5});
+  State::set(s.v, 1, {-0.5, 2.0, 0.0});
+  return s;
+}
+
+TEST(SpringJacobian, MatchesFiniteDifferencesWhenStretched) {
+  const Model model(test::singleSpring(200.0, 0.0, 0.3, 0.01));
+  const State s = twoPoints(0.45);
+  const Assembled a = assemble(model, s, {});
+  EXPECT_EQ(a.clamps, 0);
+  EXPECT_LT(relativeError(a.K, finiteDifferences(model, s, false)), 1e-6);
+}
+
+TEST(SpringJacobian, MatchesFiniteDifferencesWhenCompressedWithoutTheClamp) {
+  const Model model(test::singleSpring(200.0, 0.0, 0.3, 0.01));
+  const State s = twoPoints(0.2);
+  const Assembled a = assemble(model, s, {.clampCompression = false});
+  EXPECT_LT(relativeError(a.K, finiteDifferences(model, s, false)), 1e-6);
+  // Unclamped, the element Hessian -K has a negative direction (across the spring).
+  EXPECT_LT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(-a.K).eigenvalues().minCoeff(), -1.0);
+}
+
+TEST(SpringJacobian, ClampedUnderCompressionIsSemidefiniteAndCounted) {
+  const Model model(test::singleSpring(200.0, 0.0, 0.3, 0.01));
+  const State s = twoPoints(0.2);
+  const Assembled a = assemble(model, s, {});
+  EXPECT_EQ(a.clamps, 1);
+  const Eigen::VectorXd eig = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(-a.K).eigenvalues();
+  EXPECT_GT(eig.minCoeff(), -1e-12);
+  EXPECT_NEAR(eig.maxCoeff(), 2 * 200.0, 1e-9);  // along the spring: 2k for the pair
+}
+
+TEST(SpringDampingJacobian, MatchesFiniteDifferencesInVelocity) {
+  const Model model(test::singleSpring(200.0, 0.7, 0.3, 0.01));
+  const State s = twoPoints(0.4);
+  EXPECT_LT(relativeError(assemble(model, s, {}).D, finiteDifferences(model, s, true)), 1e-6);
+}
+
+// One point, no springs, with the given effects.
+ModelSpec onePoint(bool walls) {
+  ModelSpec spec;
+  spec.numPoints = 1;
+  spec.mass = 0.01;
+  spec.walls = walls;
+  spec.contact = {1000.0, 0.3};
+  return spec;
+}
+
+State at(const Vec3& x, const Vec3& v = {0.3, -0.2, 0.1}) {
+  State s;
+  s.x.resize(3);
+  s.v.resize(3);
+  State::set(s.x, 0, x);
+  State::set(s.v, 0, v);
+  return s;
+}
+
+TEST(ContactJacobian, MatchesFiniteDifferencesAtEachWall) {
+  const Model model(onePoint(true));
+  for (int axis = 0; axis < 3; ++axis) {
+    for (double side : {-1.0, 1.0}) {
+      double c[3] = {0.3, -0.4, 0.5};
+      c[axis] = side * 2.05;
+      const State s = at({c[0], c[1], c[2]});
+      const Assembled a = assemble(model, s, {});
+      EXPECT_LT(relativeError(a.K, finiteDifferences(model, s, false)), 1e-6);
+      EXPECT_LT(relativeError(a.D, finiteDifferences(model, s, true)), 1e-6);
+    }
+  }
+  const State corner = at({2.1, -2.05, 2.2});
+  EXPECT_LT(relativeError(assemble(model, corner, {}).K, finiteDifferences(model, corner, false)),
+            1e-6);
+}
+
+TEST(ContactJacobian, MatchesFiniteDifferencesBelowThePlane) {
+  ModelSpec spec = onePoint(false);
+  spec.plane = Plane{-1, 1, 2, 6};  // gravity.w's
+  const Model model(spec);
+  const State s = at({0.5, -1.0, -2.4});  // -0.5 - 1 - 4.8 + 6 < 0
+  const Assembled a = assemble(model, s, {});
+  EXPECT_LT(relativeError(a.K, finiteDifferences(model, s, false)), 1e-6);
+  EXPECT_LT(relativeError(a.D, finiteDifferences(model, s, true)), 1e-6);
+}
+
+TEST(ContactJacobian, MatchesFiniteDifferencesInsideTheSphere) {
+  ModelSpec spec = onePoint(false);
+  spec.sphere = Sphere{{0.0, 0.0, -1.0}, 0.6};
+  const Model model(spec);
+  const State s = at({0.2, -0.1, -0.6}, {0, 0, 0});  // the damping's x-term is omitted
+  const Assembled exact = assemble(model, s, {.clampCompression = false});
+  EXPECT_LT(relativeError(exact.K, finiteDifferences(model, s, false)), 1e-6);
+  // Clamped, the curvature term is dropped and -K is semidefinite.
+  const Assembled clamped = assemble(model, s, {});
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(-clamped.K).eigenvalues().minCoeff(),
+            -1e-12);
+}
+
+TEST(FieldJacobian, MatchesFiniteDifferencesInsideACell) {
+  ModelSpec spec = onePoint(false);
+  SceneSpec scene;
+  scene.fieldResolution = 5;
+  World bumpy = buildWorld(scene);
+  for (int i = 0; i < 125; ++i) {
+    bumpy.field.forces[i] = {std::sin(i * 0.7), std::cos(i * 1.3), 0.1 * i};
+  }
+  spec.field = bumpy.field;
+  const Model model(spec);
+  const State s = at({0.3, -0.7, 1.2});
+  const Assembled a = assemble(model, s, {.includeField = true});
+  EXPECT_LT(relativeError(a.K, finiteDifferences(model, s, false)), 1e-6);
+  EXPECT_EQ(assemble(model, s, {}).K.cwiseAbs().maxCoeff(), 0.0);  // off by default
+}
+
+// jello.w deformed at random, some points through the walls and the plane, moving.
+State deformedJello(const World& w) {
+  State s = initialState(w);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.04, 0.04);
+  for (Eigen::Index i = 0; i < s.x.size(); ++i) s.x[i] += u(rng);
+  for (Eigen::Index i = 0; i < s.v.size(); ++i) s.v[i] = 50 * u(rng);
+  const int n = s.numPoints();
+  s.x[0] = -2.1;            // point 0 through the x = -2 wall
+  s.x[2 * n + 7] = 2.15;    // point 7 through the top
+  s.x[n + 300] = -1.0;      // point 300 (x near 0.7, z near 0.4) below the plane -x+y+z+2=0
+  s.x[2 * n + 300] = -1.5;
+  return s;
+}
+
+TEST(AssembledJacobian, MatchesFiniteDifferencesOnADeformedMovingJello) {
+  World w = test::loadWorld("jello.w");
+  const State s = deformedJello(w);
+  // D against the full model (forces are linear in v).
+  const Model damped(w);
+  EXPECT_LT(relativeError(assemble(damped, s, {}).D, finiteDifferences(damped, s, true)), 1e-6);
+  // K against a model without damping: the damping's x-derivative is omitted by design.
+  w.dElastic = w.dCollision = 0.0;
+  const Model model(w);
+  const Assembled a = assemble(model, s, {.clampCompression = false});
+  EXPECT_LT(relativeError(a.K, finiteDifferences(model, s, false)), 1e-6);
+  // K is symmetric without the field.
+  EXPECT_LT((a.K - a.K.transpose()).cwiseAbs().maxCoeff(), 1e-9);
+}
+
+TEST(AssembledJacobian, ClampedSystemIsPositiveDefiniteForAnyStep) {
+  World w = test::loadWorld("jello.w");
+  w.kElastic = 1e5;
+  State s = deformedJello(w);
+  s.x *= 0.6;  // compress every spring
+  const Model model(w);
+  JacobianAssembler jac(model);
+  jac.assemble(s.x.data(), s.v.data(), {});
+  EXPECT_GT(jac.lastClampCount(), 1000);
+  SparseMatrix A = jac.pattern();
+  jac.combine(0.05, 0.05 * 0.05, A);
+  EXPECT_EQ(Eigen::LLT<Eigen::MatrixXd>(Eigen::MatrixXd(A)).info(), Eigen::Success);
+}
+
+}  // namespace
+}  // namespace jello
