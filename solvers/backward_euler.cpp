@@ -1,5 +1,6 @@
 #include "backward_euler.h"
 
+#include <algorithm>
 #include <chrono>
 
 namespace jello {
@@ -49,12 +50,21 @@ StepResult BackwardEuler::step(const Model& model, State& s, double h) {
 
   int iterations = 1;
   lastResidual_ = 0.0;
-  if (options_.newtonIterations > 1) {
+  int maxIterations = options_.newtonIterations;
+  double tolerance = options_.newtonTolerance;
+  if (model.contactBegins(s.x.data(), x1_.data())) {
+    if (options_.contactNewtonIterations > maxIterations) {
+      maxIterations = options_.contactNewtonIterations;
+      tolerance = std::max(tolerance, options_.contactNewtonTolerance);
+    }
+    ++contactSteps_;
+  }
+  if (maxIterations > 1) {
     // Newton on g(v1): (M - h D - h^2 K)(x1, v1) delta = -g.
     for (;;) {
       lastResidual_ = residual(model, s, h);
-      if (lastResidual_ <= options_.newtonTolerance) break;
-      if (iterations >= options_.newtonIterations) {
+      if (lastResidual_ <= tolerance) break;
+      if (iterations >= maxIterations) {
         ++unconverged_;
         break;
       }
@@ -80,6 +90,7 @@ std::vector<Statistic> BackwardEuler::statistics() const {
   std::vector<Statistic> stats{
       {"newton_iterations", static_cast<double>(newtonIterations_)},
       {"newton_unconverged_steps", static_cast<double>(unconverged_)},
+      {"contact_onset_steps", static_cast<double>(contactSteps_)},
       {"compression_clamps", static_cast<double>(clampCount())},
       {"factorizations", static_cast<double>(ls.factorizations)},
       {"ldlt_fallbacks", static_cast<double>(ls.fallbacks)},

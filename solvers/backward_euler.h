@@ -5,6 +5,11 @@
 //   g(v1) = M (v1 - v0) - h f(x0 + h v1, v1)
 // driven below newtonTolerance relative to |M (v1 - v0)| + |h f|. It never blows up on a
 // linear system and removes energy: an undamped mode keeps 1/(1 + h^2 w^2) of it per step.
+// A step in which a contact begins (a point reaches a wall, the plane or the sphere that it was
+// clear of at the step's start) is Newton-iterated too (up to contactNewtonIterations): the
+// linearized step does not know the penalty spring, lets the point in deep, and stores a large
+// spurious contact energy (measured: 700x the total energy for a cube thrown at 20 m/s into a
+// wall with kCollision = 10^5 at h = 0.01).
 // The force field is treated explicitly (its gradient is not symmetric).
 #pragma once
 
@@ -44,7 +49,7 @@ class BackwardEuler final : public Integrator {
   Eigen::VectorXd f_, rhs_, dv_, v1_, x1_, g_;
   double lastResidual_ = 0.0;
   int lastIterations_ = 0;
-  long steps_ = 0, newtonIterations_ = 0, unconverged_ = 0;
+  long steps_ = 0, newtonIterations_ = 0, unconverged_ = 0, contactSteps_ = 0;
   double assembleSeconds_ = 0.0;
 };
 

@@ -95,6 +95,7 @@ StepResult CvodeIntegrator::start(const Model& model, const State& s) {
   std::memcpy(y + n3_, s.v.data(), static_cast<std::size_t>(n3_) * sizeof(double));
   t_ = s.t;
   assembled_ = false;
+  ++restarts_;
 
   if (sameModel) {
     if (int f = CVodeReInit(cvode_.get(), s.t, y_.get()); f != CV_SUCCESS) {
@@ -206,6 +207,7 @@ std::vector<Statistic> CvodeIntegrator::statistics() const {
   add("error_test_failures", CVodeGetNumErrTestFails);
   int order = 0;
   if (CVodeGetLastOrder(mem, &order) == CV_SUCCESS) stats.push_back({"last_order", double(order)});
+  stats.push_back({"starts", double(restarts_)});  // 1 + restarts from a state set outside
   if (jacobian_) stats.push_back({"compression_clamps", double(jacobian_->totalClampCount())});
   if (solver_) {
     stats.push_back({"factorizations", double(solver_->stats().factorizations)});

@@ -52,6 +52,7 @@ class CvodeIntegrator final : public Integrator {
   bool assembled_ = false;
   Eigen::VectorXd rhs_, b_;
   double t_ = 0.0;  // CVODE's time, to notice a state changed from outside
+  long restarts_ = 0;
 };
 
 }  // namespace jello

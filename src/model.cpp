@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 
 namespace jello {
 
@@ -73,6 +74,27 @@ void Model::acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
   assert(x.size() == 3 * n_ && v.size() == 3 * n_);
   a.resize(3 * n_);
   acceleration(x.data(), v.data(), a.data());
+}
+
+bool Model::contactBegins(const double* x0, const double* x1) const {
+  const int n = n_;
+  if (walls_) {
+    for (int i = 0; i < 3 * n; ++i) {
+      if (std::abs(x1[i]) > kBoxHalfSize && std::abs(x0[i]) <= kBoxHalfSize) return true;
+    }
+  }
+  for (int p = 0; p < n; ++p) {
+    const Vec3 a{x0[p], x0[n + p], x0[2 * n + p]}, b{x1[p], x1[n + p], x1[2 * n + p]};
+    if (plane_) {
+      const auto side = [&](const Vec3& x) { return dot(plane_->normal(), x) + plane_->offset(); };
+      if (side(b) < 0.0 && side(a) >= 0.0) return true;
+    }
+    if (sphere_) {
+      const Sphere& s = sphere_->sphere();
+      if (norm(b - s.center) < s.radius && norm(a - s.center) >= s.radius) return true;
+    }
+  }
+  return false;
 }
 
 Energy Model::energy(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const {

@@ -67,6 +67,10 @@ class Model {
   void acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                     Eigen::VectorXd& a) const;
 
+  // True when some point is in contact (with a wall, the plane or the sphere) at positions x1
+  // but was not at x0: the contact set changed between them.
+  bool contactBegins(const double* x0, const double* x1) const;
+
   Energy energy(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const;
   Energy energy(const State& s) const { return energy(s.x, s.v); }
 
