@@ -16,9 +16,9 @@ int slotOf(const SparseMatrix& m, int row, int col) {
   return static_cast<int>(it - m.innerIndexPtr());
 }
 
-// Adds sign * B (3x3, row-major) into the 9 slots starting at `slots`.
-inline void addBlock(double* values, const int* slots, const double B[9], double sign) {
-  for (int e = 0; e < 9; ++e) values[slots[e]] += sign * B[e];
+// block += B, both 3x3 row-major.
+inline void addBlock(double* block, const double B[9]) {
+  for (int e = 0; e < 9; ++e) block[e] += B[e];
 }
 
 }  // namespace
@@ -54,15 +54,15 @@ JacobianAssembler::JacobianAssembler(const Model& model) : model_(model) {
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) out.push_back(slotOf(K_, r * n + p, c * n + q));
   };
-  springSlots_.reserve(36 * springs_.size());
+  springSlots_.reserve(18 * springs_.size());
   for (const Spring& s : springs_) {
-    slots(springSlots_, s.a, s.a);
-    slots(springSlots_, s.b, s.b);
     slots(springSlots_, s.a, s.b);
     slots(springSlots_, s.b, s.a);
   }
   diagSlots_.reserve(9 * static_cast<std::size_t>(n));
   for (int p = 0; p < n; ++p) slots(diagSlots_, p, p);
+  diagK_.resize(9 * static_cast<std::size_t>(n));
+  diagD_.resize(9 * static_cast<std::size_t>(n));
   for (int i = 0; i < 3 * n; ++i) diagonal_.push_back(slotOf(K_, i, i));
 }
 
@@ -72,37 +72,44 @@ void JacobianAssembler::assemble(const double* x, const double* v,
   const int n = model_.numPoints();
   double* Kv = K_.valuePtr();
   double* Dv = D_.valuePtr();
-  std::fill(Kv, Kv + K_.nonZeros(), 0.0);
-  std::fill(Dv, Dv + D_.nonZeros(), 0.0);
+  // Diagonal blocks gather from many springs and from contact: into dense per-point arrays,
+  // scattered into the matrices once at the end. Each off-diagonal block belongs to exactly one
+  // spring, which assigns it: no zeroing, no accumulation.
+  std::fill(diagK_.begin(), diagK_.end(), 0.0);
+  std::fill(diagD_.begin(), diagD_.end(), 0.0);
 
   long clamps = 0;
   for (std::size_t s = 0; s < springs_.size(); ++s) {
     const int a = springs_[s].a, b = springs_[s].b;
     const double d[3] = {x[b] - x[a], x[n + b] - x[n + a], x[2 * n + b] - x[2 * n + a]};
-    const double l = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    const double u[3] = {d[0] / l, d[1] / l, d[2] / l};
-    double alpha = 1.0 - springs_[s].rest / l;
+    const double inv = 1.0 / std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    const double u[3] = {d[0] * inv, d[1] * inv, d[2] * inv};
+    double alpha = 1.0 - springs_[s].rest * inv;
     if (options.clampCompression && alpha < 0.0) {
       alpha = 0.0;
       ++clamps;
     }
     const double k = stiffness_[s], c = damping_[s];
-    double Ke[9], De[9];
+    const int* slot = &springSlots_[18 * s];
+    double* Ka = &diagK_[9 * static_cast<std::size_t>(a)];
+    double* Kb = &diagK_[9 * static_cast<std::size_t>(b)];
+    double* Da = &diagD_[9 * static_cast<std::size_t>(a)];
+    double* Db = &diagD_[9 * static_cast<std::size_t>(b)];
     for (int r = 0; r < 3; ++r)
       for (int q = 0; q < 3; ++q) {
+        const int e = 3 * r + q;
         const double P = u[r] * u[q];
-        Ke[3 * r + q] = -k * (P + alpha * ((r == q ? 1.0 : 0.0) - P));
-        De[3 * r + q] = -c * P;
+        const double Ke = -k * (P + alpha * ((r == q ? 1.0 : 0.0) - P));
+        const double De = -c * P;
+        Ka[e] += Ke;
+        Kb[e] += Ke;
+        Da[e] += De;
+        Db[e] += De;
+        Kv[slot[e]] = -Ke;  // (a,b)
+        Kv[slot[9 + e]] = -Ke;  // (b,a)
+        Dv[slot[e]] = -De;
+        Dv[slot[9 + e]] = -De;
       }
-    const int* slot = &springSlots_[36 * s];
-    addBlock(Kv, slot, Ke, 1.0);
-    addBlock(Kv, slot + 9, Ke, 1.0);
-    addBlock(Kv, slot + 18, Ke, -1.0);
-    addBlock(Kv, slot + 27, Ke, -1.0);
-    addBlock(Dv, slot, De, 1.0);
-    addBlock(Dv, slot + 9, De, 1.0);
-    addBlock(Dv, slot + 18, De, -1.0);
-    addBlock(Dv, slot + 27, De, -1.0);
   }
   lastClamps_ = clamps;
   totalClamps_ += clamps;
@@ -116,23 +123,24 @@ void JacobianAssembler::assemble(const double* x, const double* v,
   double B[9];
   for (int p = 0; p < n; ++p) {
     const Vec3 xp{x[p], x[n + p], x[2 * n + p]};
-    const int* slot = &diagSlots_[9 * p];
+    double* Kp = &diagK_[9 * static_cast<std::size_t>(p)];
+    double* Dp = &diagD_[9 * static_cast<std::size_t>(p)];
     if (const auto& walls = model_.walls()) {
       const ContactConstants& kc = walls->constants();
       const double coord[3] = {xp.x, xp.y, xp.z};
       for (int axis = 0; axis < 3; ++axis) {
         if (std::abs(coord[axis]) <= kBoxHalfSize) continue;
-        Kv[slot[4 * axis]] -= kc.stiffness;  // entry (axis, axis) of the block
-        Dv[slot[4 * axis]] -= kc.damping;
+        Kp[4 * axis] -= kc.stiffness;  // entry (axis, axis) of the block
+        Dp[4 * axis] -= kc.damping;
       }
     }
     if (const auto& plane = model_.plane()) {
       const Vec3 nrm = plane->normal();
       if (dot(nrm, xp) + plane->offset() < 0.0) {
         normalBlock(nrm, -plane->constants().stiffness, B);
-        addBlock(Kv, slot, B, 1.0);
+        addBlock(Kp, B);
         normalBlock(nrm, -plane->constants().damping, B);
-        addBlock(Dv, slot, B, 1.0);
+        addBlock(Dp, B);
       }
     }
     if (const auto& sphere = model_.sphere()) {
@@ -145,16 +153,20 @@ void JacobianAssembler::assemble(const double* x, const double* v,
         const double t = options.clampCompression ? 0.0 : kc.stiffness * (R / l - 1.0);
         normalBlock(nrm, -kc.stiffness - t, B);
         for (int e = 0; e < 3; ++e) B[4 * e] += t;
-        addBlock(Kv, slot, B, 1.0);
+        addBlock(Kp, B);
         normalBlock(nrm, -kc.damping, B);
-        addBlock(Dv, slot, B, 1.0);
+        addBlock(Dp, B);
       }
     }
     if (options.includeField && model_.field()) {
       double G[3][3];
       model_.field()->gradient(xp, G);
-      addBlock(Kv, slot, &G[0][0], 1.0);
+      addBlock(Kp, &G[0][0]);
     }
+  }
+  for (std::size_t i = 0; i < diagSlots_.size(); ++i) {
+    Kv[diagSlots_[i]] = diagK_[i];
+    Dv[diagSlots_[i]] = diagD_[i];
   }
 }
 

@@ -54,8 +54,9 @@ class JacobianAssembler {
   std::vector<Spring> springs_;
   std::vector<double> stiffness_, damping_;  // per spring
   SparseMatrix K_, D_;
-  std::vector<int> springSlots_;  // 36 per spring: value index of (block, row, column)
+  std::vector<int> springSlots_;  // 18 per spring: value index of blocks (a,b), (b,a)
   std::vector<int> diagSlots_;    // 9 per point: value index of its diagonal block
+  std::vector<double> diagK_, diagD_;  // 9 per point: diagonal blocks gathered densely
   std::vector<int> diagonal_;     // value index of each diagonal entry (for the mass)
   long lastClamps_ = 0, totalClamps_ = 0;
 };

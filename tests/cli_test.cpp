@@ -87,6 +87,30 @@ TEST(JelloSim, ReportsDivergenceWithExitCodeThreeAndWritesNoWorld) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+TEST(JelloSim, ImplicitIntegratorsRunTheStiffSceneThatExplicitOnesCannot) {
+  test::TempDir dir;
+  const auto stiff = dir.path() / "stiff.w", stats = dir.path() / "s.json";
+  writeWorld(buildWorld(stiffCube(1e4)), stiff);
+  EXPECT_EQ(run(sim() + " " + stiff.string() + " --integrator euler --dt 0.01 -q").code, 3);
+  const Outcome r = run(sim() + " " + stiff.string() +
+                        " --integrator implicit --dt 0.01 --time 0.1 --stats " + stats.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "factorizations")) << r.output;
+  const auto json = nlohmann::json::parse(test::readFile(stats));
+  EXPECT_EQ(json["integrator"], "implicit");
+  EXPECT_EQ(json["solver"]["factorizations"], 10);
+  EXPECT_GT(json["solver"]["compression_clamps"].get<double>(), 0.0);
+
+  const Outcome c = run(sim() + " " + stiff.string() +
+                        " --integrator cvode --dt 0.01 --time 0.02 --rtol 1e-3 --max-order 2"
+                        " --linear-solver cg --stats " + stats.string());
+  ASSERT_EQ(c.code, 0) << c.output;
+  const auto cj = nlohmann::json::parse(test::readFile(stats));
+  EXPECT_EQ(cj["steps"], 2);  // output intervals
+  EXPECT_GT(cj["solver"]["cvode_steps"].get<double>(), 2.0);
+  EXPECT_LE(cj["solver"]["last_order"].get<double>(), 2.0);
+}
+
 TEST(JelloSim, RefusesABadWorldNamingFileAndLine) {
   test::TempDir dir;
   const auto bad = dir.path() / "bad.w";

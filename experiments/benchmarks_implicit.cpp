@@ -1,0 +1,180 @@
+// Speed of the implicit machinery (Google Benchmark). Figures are reported in the README.
+//   BM_Refill/N          assemble K and D in place at a deformed state
+//   BM_Factorize/N       CHOLMOD supernodal LLT of M - h D - h^2 K, h = 0.01
+//   BM_Solve/N           CHOLMOD triangular solves
+//   BM_CgSolve/N         Jacobi-CG at tolerance 1e-6, warm-started from the last step
+//   BM_ImplicitStep/<solver>/N  one backward-Euler step at dt = 0.01 on jello.w at N^3
+//   BM_CvodeOneSecond/<rtol>    jello.w for 1 simulated second (counters: CVODE statistics)
+//   BM_StiffOneSecond/<method>  stiffCube(1e5) for 1 simulated second: implicit at dt = 0.01
+//                               against RK4 at its largest stable dt (found by bisection)
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "backward_euler.h"
+#include "jacobian.h"
+#include "linear_solver.h"
+#include "scene_builder.h"
+#include "simulation.h"
+#include "world_reader.h"
+
+namespace {
+
+using namespace jello;
+
+World jelloAt(int n) {
+  return resampleCube(readWorld(std::filesystem::path(JELLO_WORLDS_DIR) / "jello.w"), n);
+}
+
+// jello.w after 0.05 s of RK4: deformed, moving, in contact with nothing in particular.
+State movingState(const World& w) {
+  Simulation sim(w);
+  for (int i = 0; i < 100; ++i) (void)sim.step();
+  return sim.state();
+}
+
+void BM_Refill(benchmark::State& st) {
+  const World w = jelloAt(static_cast<int>(st.range(0)));
+  const Model model(w);
+  const State s = movingState(w);
+  JacobianAssembler jac(model);
+  for (auto _ : st) {
+    jac.assemble(s.x.data(), s.v.data(), {});
+    benchmark::DoNotOptimize(jac.K().valuePtr());
+  }
+  st.counters["nonzeros"] = static_cast<double>(jac.K().nonZeros());
+}
+BENCHMARK(BM_Refill)->Arg(8)->Arg(16)->Unit(benchmark::kMicrosecond);
+
+struct System {
+  World w;
+  Model model;
+  State s;
+  JacobianAssembler jac;
+  SparseMatrix A;
+  Eigen::VectorXd b;
+  explicit System(int n) : w(jelloAt(n)), model(w), s(movingState(w)), jac(model) {
+    jac.assemble(s.x.data(), s.v.data(), {});
+    A = jac.pattern();
+    jac.combine(0.01, 1e-4, A);
+    model.forces(s.x, s.v, b);
+    b *= 0.01;
+  }
+};
+
+void BM_Factorize(benchmark::State& st) {
+  System sys(static_cast<int>(st.range(0)));
+  SpdSolver solver(LinearSolverKind::Cholmod);
+  for (auto _ : st) {
+    if (!solver.factorize(sys.A).ok) st.SkipWithError("factorization failed");
+  }
+}
+BENCHMARK(BM_Factorize)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond);
+
+void BM_Solve(benchmark::State& st) {
+  System sys(static_cast<int>(st.range(0)));
+  SpdSolver solver(LinearSolverKind::Cholmod);
+  if (!solver.factorize(sys.A).ok) st.SkipWithError("factorization failed");
+  Eigen::VectorXd x;
+  for (auto _ : st) {
+    if (!solver.solve(sys.b, x).ok) st.SkipWithError("solve failed");
+  }
+}
+BENCHMARK(BM_Solve)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond);
+
+void BM_CgSolve(benchmark::State& st) {
+  System sys(static_cast<int>(st.range(0)));
+  SpdSolver solver(LinearSolverKind::Cg);
+  if (!solver.factorize(sys.A).ok) st.SkipWithError("set-up failed");
+  Eigen::VectorXd x0;
+  if (!solver.solve(sys.b, x0).ok) st.SkipWithError("solve failed");
+  // A warm start as in a time step: last step's answer, the right-hand side moved by 1%.
+  const Eigen::VectorXd b = sys.b * 1.01;
+  for (auto _ : st) {
+    Eigen::VectorXd x = x0;
+    if (!solver.solve(b, x).ok) st.SkipWithError("solve failed");
+  }
+  st.counters["iterations"] = benchmark::Counter(static_cast<double>(solver.stats().cgIterations),
+                                                 benchmark::Counter::kAvgIterations);
+}
+BENCHMARK(BM_CgSolve)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond);
+
+void BM_ImplicitStep(benchmark::State& st, LinearSolverKind kind) {
+  SolverOptions options;
+  options.implicit.linearSolver = kind;
+  Simulation sim(jelloAt(static_cast<int>(st.range(0))), IntegratorKind::Implicit, 0.01, options);
+  for (auto _ : st) {
+    if (!sim.step().ok) st.SkipWithError("step failed");
+  }
+  st.SetItemsProcessed(st.iterations());
+}
+BENCHMARK_CAPTURE(BM_ImplicitStep, cholmod, LinearSolverKind::Cholmod)
+    ->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ImplicitStep, cg, LinearSolverKind::Cg)
+    ->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond);
+
+// Runs `sim` to t = 1 s; false if it diverged.
+bool runOneSecond(Simulation& sim) {
+  const long steps = std::lround(1.0 / sim.dt());
+  for (long i = 0; i < steps; ++i) {
+    if (!sim.step().ok) return false;
+  }
+  return true;
+}
+
+void BM_CvodeOneSecond(benchmark::State& st, double rtol, LinearSolverKind kind) {
+  SolverOptions options;
+  options.cvode.rtol = rtol;
+  options.cvode.linearSolver = kind;
+  for (auto _ : st) {
+    Simulation sim(jelloAt(8), IntegratorKind::Cvode, 0.01, options);
+    if (!runOneSecond(sim)) st.SkipWithError("cvode failed");
+    for (const Statistic& s : sim.integratorState().statistics()) st.counters[s.name] = s.value;
+  }
+}
+BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e3_cholmod, 1e-3, LinearSolverKind::Cholmod)
+    ->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e3_cg, 1e-3, LinearSolverKind::Cg)
+    ->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e6_cholmod, 1e-6, LinearSolverKind::Cholmod)
+    ->Iterations(1)->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e6_cg, 1e-6, LinearSolverKind::Cg)
+    ->Iterations(1)->Unit(benchmark::kSecond);
+
+// The largest dt at which RK4 runs the stiff cube for 0.1 s without diverging (bisection to
+// 1%), then 5% below it for safety over the full second.
+double largestStableRk4Step(const World& w) {
+  double stable = 1e-6, unstable = 1e-2;
+  while (unstable / stable > 1.01) {
+    const double dt = std::sqrt(stable * unstable);
+    Simulation sim(w, IntegratorKind::RK4, dt);
+    bool ok = true;
+    for (long i = 0; ok && i < std::lround(0.1 / dt); ++i) ok = sim.step().ok;
+    (ok ? stable : unstable) = dt;
+  }
+  return 0.95 * stable;
+}
+
+void BM_StiffOneSecond(benchmark::State& st, IntegratorKind kind, LinearSolverKind solver) {
+  const World w = buildWorld(stiffCube(1e5));
+  const double dt = kind == IntegratorKind::RK4 ? largestStableRk4Step(w) : 0.01;
+  SolverOptions options;
+  options.implicit.linearSolver = solver;
+  for (auto _ : st) {
+    Simulation sim(w, kind, dt, options);
+    if (!runOneSecond(sim)) st.SkipWithError("diverged");
+  }
+  st.counters["dt_s"] = dt;
+}
+BENCHMARK_CAPTURE(BM_StiffOneSecond, rk4_at_its_limit, IntegratorKind::RK4,
+                  LinearSolverKind::Cholmod)
+    ->Iterations(3)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_StiffOneSecond, implicit_cholmod_dt001, IntegratorKind::Implicit,
+                  LinearSolverKind::Cholmod)
+    ->Iterations(3)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_StiffOneSecond, implicit_cg_dt001, IntegratorKind::Implicit,
+                  LinearSolverKind::Cg)
+    ->Iterations(3)->Unit(benchmark::kMillisecond);
+
+}  // namespace
