@@ -23,11 +23,11 @@ void BackwardEuler::assemble(const double* x, const double* v) {
                           .count();
 }
 
-// Factors M - h D - h^2 K of the last assembly and solves it for rhs into dv_.
-StepResult BackwardEuler::factorAndSolve(double h, const Eigen::VectorXd& rhs) {
+StepResult BackwardEuler::factorAndSolve(double h, const Eigen::VectorXd& rhs,
+                                         Eigen::VectorXd& x) {
   jacobian_->combine(h, h * h, A_);
   if (StepResult r = solver_.factorize(A_); !r.ok) return r;
-  return solver_.solve(rhs, dv_);  // dv_ holds the last solution: CG's warm start
+  return solver_.solve(rhs, x);
 }
 
 double BackwardEuler::residual(const Model& model, const State& s, double h) {
@@ -44,7 +44,8 @@ StepResult BackwardEuler::step(const Model& model, State& s, double h) {
   assemble(s.x.data(), s.v.data());
   rhs_.noalias() = jacobian_->K() * s.v;
   rhs_ = h * (f_ + h * rhs_);
-  if (StepResult r = factorAndSolve(h, rhs_); !r.ok) return r;
+  // dv_ still holds the last step's dv: a good first guess for CG.
+  if (StepResult r = factorAndSolve(h, rhs_, dv_); !r.ok) return r;
   v1_ = s.v + dv_;
   x1_ = s.x + h * v1_;
 
@@ -70,8 +71,9 @@ StepResult BackwardEuler::step(const Model& model, State& s, double h) {
       }
       rhs_ = -g_;
       assemble(x1_.data(), v1_.data());
-      if (StepResult r = factorAndSolve(h, rhs_); !r.ok) return r;
-      v1_ += dv_;
+      delta_.setZero(rhs_.size());  // a correction: small, so start CG from zero
+      if (StepResult r = factorAndSolve(h, rhs_, delta_); !r.ok) return r;
+      v1_ += delta_;
       x1_ = s.x + h * v1_;
       ++iterations;
     }

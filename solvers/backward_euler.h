@@ -39,14 +39,16 @@ class BackwardEuler final : public Integrator {
   void prepare(const Model& model);
   double residual(const Model& model, const State& s, double h);
   void assemble(const double* x, const double* v);
-  StepResult factorAndSolve(double h, const Eigen::VectorXd& rhs);
+  // Factors M - h D - h^2 K of the last assembly and solves it for rhs into x (x on entry:
+  // CG's initial guess).
+  StepResult factorAndSolve(double h, const Eigen::VectorXd& rhs, Eigen::VectorXd& x);
 
   ImplicitOptions options_;
   const Model* model_ = nullptr;
   std::unique_ptr<JacobianAssembler> jacobian_;
   SparseMatrix A_;
   SpdSolver solver_;
-  Eigen::VectorXd f_, rhs_, dv_, v1_, x1_, g_;
+  Eigen::VectorXd f_, rhs_, dv_, delta_, v1_, x1_, g_;  // dv_: the last step's, CG's warm start
   double lastResidual_ = 0.0;
   int lastIterations_ = 0;
   long steps_ = 0, newtonIterations_ = 0, unconverged_ = 0, contactSteps_ = 0;
