@@ -12,29 +12,15 @@ namespace jello {
 namespace {
 
 TEST(BackwardEuler, UndampedLinearSpringKeepsOneOverOnePlusH2W2OfItsEnergyPerStep) {
-  // Zero rest length: the force is exactly linear, and the relative motion of the two points
-  // is an undamped oscillator with w = sqrt(2k/m).
-  const double k = 2.0, m = 0.01;
-  const Model model(test::singleSpring(k, 0.0, 0.0, m));
-  State s;
-  s.x.resize(6);
-  s.v.resize(6);
-  State::set(s.x, 0, {-0.3, 0.2, 0.1});
-  State::set(s.x, 1, {0.3, -0.2, -0.1});
-  State::set(s.v, 0, {0.5, 1.0, -2.0});
-  State::set(s.v, 1, {-0.5, -1.0, 2.0});
-  auto energy = [&](const State& st) {
-    const Vec3 d = st.position(1) - st.position(0);
-    return 0.5 * m * st.v.squaredNorm() + 0.5 * k * dot(d, d);
-  };
-  const double w = std::sqrt(2 * k / m);
+  const test::LinearOscillator osc;
   for (double y : {0.1, 1.0, 10.0}) {
     BackwardEuler be;
-    const double h = y / w;
+    State s = osc.start();
+    const double h = y / osc.omega();
     for (int i = 0; i < 10; ++i) {
-      const double before = energy(s);
-      ASSERT_TRUE(be.step(model, s, h).ok);
-      EXPECT_NEAR(energy(s) / before, 1.0 / (1.0 + y * y), 1e-10) << "y " << y << " step " << i;
+      const double before = osc.energy(s);
+      ASSERT_TRUE(be.step(osc.model, s, h).ok);
+      EXPECT_NEAR(osc.energy(s) / before, 1.0 / (1.0 + y * y), 1e-10) << "y " << y << " step " << i;
     }
   }
 }

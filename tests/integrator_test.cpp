@@ -9,28 +9,7 @@
 namespace jello {
 namespace {
 
-// Two points of mass m joined by a spring of rest length 0: the force k (x_j - x_i) is exactly
-// linear, so the relative motion is an undamped isotropic oscillator with w = sqrt(2k/m). The
-// centre of mass stays at the origin, so the energy is that of the relative motion.
-struct Oscillator {
-  double mass = 0.01, stiffness = 2.0;
-  Model model{test::singleSpring(stiffness, 0.0, 0.0, mass)};
-  double omega() const { return std::sqrt(2 * stiffness / mass); }
-  double energy(const State& s) const {
-    const Vec3 d = s.position(1) - s.position(0);
-    return 0.5 * mass * s.v.squaredNorm() + 0.5 * stiffness * dot(d, d);
-  }
-  State start() const {
-    State s;
-    s.x.resize(6);
-    s.v.resize(6);
-    State::set(s.x, 0, {-0.3, 0.2, 0.1});
-    State::set(s.x, 1, {0.3, -0.2, -0.1});
-    State::set(s.v, 0, {0.5, 1.0, -2.0});
-    State::set(s.v, 1, {-0.5, -1.0, 2.0});
-    return s;
-  }
-};
+using Oscillator = test::LinearOscillator;
 
 // Energy ratio per step on an undamped mode of frequency w, with y = h w.
 double eulerFactor(double y) { return 1 + y * y; }

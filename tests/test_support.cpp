@@ -1,5 +1,6 @@
 #include "test_support.h"
 
+#include <cmath>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -48,6 +49,24 @@ ModelSpec singleSpring(double stiffness, double damping, double rest, double mas
   spec.springs.push_back(g);
   spec.walls = false;
   return spec;
+}
+
+double LinearOscillator::omega() const { return std::sqrt(2 * stiffness / mass); }
+
+double LinearOscillator::energy(const State& s) const {
+  const Vec3 d = s.position(1) - s.position(0);
+  return 0.5 * mass * s.v.squaredNorm() + 0.5 * stiffness * dot(d, d);
+}
+
+State LinearOscillator::start() const {
+  State s;
+  s.x.resize(6);
+  s.v.resize(6);
+  State::set(s.x, 0, {-0.3, 0.2, 0.1});
+  State::set(s.x, 1, {0.3, -0.2, -0.1});
+  State::set(s.v, 0, {0.5, 1.0, -2.0});
+  State::set(s.v, 1, {-0.5, -1.0, 2.0});
+  return s;
 }
 
 ModelSpec freeCube(const World& world) {

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "model.h"
+#include "state.h"
 #include "world.h"
 
 namespace jello::test {
@@ -28,6 +29,19 @@ class TempDir {
 
 // Two points joined by one spring along x, point 0 at the origin, no walls, no field.
 ModelSpec singleSpring(double stiffness, double damping, double rest, double mass);
+
+// Two points of mass m joined by a spring of rest length 0: the force k (x_j - x_i) is exactly
+// linear, so the relative motion is an undamped isotropic oscillator with w = sqrt(2k/m). The
+// start state keeps the centre of mass at rest at the origin, so energy() is that of the
+// relative motion.
+struct LinearOscillator {
+  double mass = 0.01, stiffness = 2.0;
+  Model model{singleSpring(stiffness, 0.0, 0.0, mass)};
+
+  double omega() const;
+  double energy(const State& s) const;
+  State start() const;
+};
 
 // jello.w's cube (skewed corner, moving) with walls, plane and field switched off: a free body.
 ModelSpec freeCube(const World& world);
