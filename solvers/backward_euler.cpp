@@ -9,7 +9,8 @@ BackwardEuler::BackwardEuler(ImplicitOptions options)
     : options_(options), solver_(options.linearSolver, options.cgTolerance) {}
 
 void BackwardEuler::prepare(const Model& model) {
-  if (model_ == &model) return;
+  // The same object with the same size: another model could reuse a freed one's address.
+  if (model_ == &model && dv_.size() == 3 * model.numPoints()) return;
   model_ = &model;
   jacobian_ = std::make_unique<JacobianAssembler>(model);
   A_ = jacobian_->pattern();
