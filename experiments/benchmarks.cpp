@@ -4,14 +4,13 @@
 //   BM_Step/<integrator>/N  one full step on jello.w resampled to N^3; items/s = steps/s
 #include <benchmark/benchmark.h>
 
-#include <unistd.h>
-
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <string>
 
+#include "runtime_environment.h"
 #include "simulation.h"
 #include "world_reader.h"
 #include "scene_builder.h"
@@ -75,14 +74,8 @@ std::string loadedBlas() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // OpenBLAS and libgomp (pulled in by CHOLMOD) read their settings when they load: pin one
-  // BLAS thread, and stop idle OpenMP threads spinning on the benchmark's core (it costs
-  // CHOLMOD's factorization 20% here), by starting again with them set.
-  if (!std::getenv("OPENBLAS_NUM_THREADS") || !std::getenv("OMP_WAIT_POLICY")) {
-    ::setenv("OPENBLAS_NUM_THREADS", "1", 0);
-    ::setenv("OMP_WAIT_POLICY", "passive", 0);
-    ::execv("/proc/self/exe", argv);
-  }
+  // One BLAS thread, and no idle OpenMP threads spinning on the benchmark's core.
+  jello::applyRuntimeEnvironment(argv, /*pinBlas=*/true);
   benchmark::AddCustomContext("blas", loadedBlas());
   benchmark::AddCustomContext("OPENBLAS_NUM_THREADS", std::getenv("OPENBLAS_NUM_THREADS"));
   benchmark::AddCustomContext("OMP_WAIT_POLICY", std::getenv("OMP_WAIT_POLICY"));

@@ -14,6 +14,7 @@
 
 #include "atomic_file.h"
 #include "progress.h"
+#include "runtime_environment.h"
 #include "scene_builder.h"
 #include "simulation.h"
 #include "world_reader.h"
@@ -178,6 +179,7 @@ int run(const Options& opt) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  jello::applyRuntimeEnvironment(argv, /*pinBlas=*/false);
   Options opt;
   CLI::App app{
       "Steps a jello world headless and prints a summary: steps, simulated and wall time, "
