@@ -1,8 +1,10 @@
 // jello-sim: steps a world headless and reports what happened.
 //   jello-sim WORLD [--integrator NAME] [--dt S] [--time S | --steps N] [--cube N]
 //             [--out FILE.w] [--trace FILE.csv --every K] [--stats FILE.json] [--quiet]
-// Exit codes: 0 done, 1 bad input or an I/O failure, 2 bad usage, 3 the simulation diverged.
+// Exit codes: 0 done, 1 bad input or an I/O failure, 2 bad usage, 3 the simulation diverged,
+// 128 + signal when interrupted by SIGINT or SIGTERM (it stops at a step boundary).
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -29,6 +31,10 @@ constexpr int kExitInput = 1;
 constexpr int kExitUsage = 2;
 constexpr int kExitDiverged = 3;
 
+volatile std::sig_atomic_t interruptSignal = 0;
+
+extern "C" void onInterrupt(int signo) { interruptSignal = signo; }
+
 struct Options {
   std::string world;
   std::string integrator;
@@ -42,6 +48,7 @@ struct Options {
   jello::SolverOptions solver;
   std::string linearSolver = "cholmod";
   bool noClamp = false, noStabLimDet = false;
+  jello::ReaderLimits limits;
 };
 
 nlohmann::json toJson(const Energy& e) {
@@ -77,7 +84,7 @@ class Trace {
 int run(const Options& opt) {
   jello::World world;
   try {
-    world = jello::readWorld(opt.world);
+    world = jello::readWorld(opt.world, opt.limits);
   } catch (const jello::WorldFileError& e) {
     std::fprintf(stderr, "jello-sim: error: %s\n", e.what());
     return kExitInput;
@@ -105,7 +112,9 @@ int run(const Options& opt) {
   jello::Progress progress(!opt.quiet, name + " steps");
   const auto t0 = std::chrono::steady_clock::now();
   bool diverged = false;
-  for (long i = 0; i < total; ++i) {
+  std::signal(SIGINT, onInterrupt);
+  std::signal(SIGTERM, onInterrupt);
+  for (long i = 0; i < total && interruptSignal == 0; ++i) {
     if (!sim.step().ok) {
       diverged = true;
       break;
@@ -114,6 +123,9 @@ int run(const Options& opt) {
     progress.update(i + 1, total);
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  const int interrupted = interruptSignal;
   progress.finish();
 
   const jello::State& s = sim.state();
@@ -133,9 +145,14 @@ int run(const Options& opt) {
       {"energy_start", toJson(start)},
       {"energy_end", toJson(end)},
       {"diverged", diverged},
+      {"interrupted", interrupted != 0},
   };
   const std::vector<jello::Statistic> solverStats = sim.integratorState().statistics();
   for (const jello::Statistic& st : solverStats) stats["solver"][st.name] = st.value;
+  if (interrupted) {
+    std::fprintf(stderr, "jello-sim: interrupted (signal %d) at t = %g s, after step %ld of %ld\n",
+                 interrupted, s.t, done, total);
+  }
   if (diverged) {
     const jello::Divergence& d = *sim.divergence();
     stats["divergence"] = {{"time_s", d.time}, {"step", d.step}, {"reason", d.reason}};
@@ -146,7 +163,8 @@ int run(const Options& opt) {
     std::printf("world        %s (%d points, %d springs)\n", opt.world.c_str(), s.numPoints(),
                 sim.model().springs().numSprings());
     std::printf("integrator   %s, dt = %g s\n", name.c_str(), dt);
-    std::printf("steps        %ld%s\n", done, diverged ? " (then diverged)" : "");
+    std::printf("steps        %ld%s\n", done,
+                diverged ? " (then diverged)" : interrupted ? " (interrupted)" : "");
     std::printf("simulated    %.6g s\n", s.t);
     std::printf("wall time    %.3f s (%.0f steps/s, %.2fx real time)\n", wall,
                 wall > 0 ? double(done) / wall : 0.0, wall > 0 ? s.t / wall : 0.0);
@@ -163,16 +181,20 @@ int run(const Options& opt) {
   try {
     if (!opt.trace.empty()) jello::writeFileAtomically(opt.trace, trace.text());
     if (!opt.stats.empty()) jello::writeFileAtomically(opt.stats, stats.dump(2) + "\n");
-    // A diverged run saves no world: its last state is not the state at the requested time.
-    if (!opt.out.empty() && !diverged) jello::writeWorld(sim.currentWorld(), opt.out);
+    // A diverged or interrupted run saves no world: its last state is not the state at the
+    // requested time. Its trace and stats are complete up to where it stopped, and say so.
+    if (!opt.out.empty() && !diverged && !interrupted) {
+      jello::writeWorld(sim.currentWorld(), opt.out);
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "jello-sim: error: %s\n", e.what());
     return kExitInput;
   }
-  if (diverged && !opt.out.empty()) {
-    std::fprintf(stderr, "jello-sim: %s not written (the simulation diverged)\n",
-                 opt.out.c_str());
+  if ((diverged || interrupted) && !opt.out.empty()) {
+    std::fprintf(stderr, "jello-sim: %s not written (the simulation %s)\n", opt.out.c_str(),
+                 diverged ? "diverged" : "was interrupted");
   }
+  if (interrupted) return 128 + interrupted;
   return diverged ? kExitDiverged : 0;
 }
 
@@ -185,7 +207,8 @@ int main(int argc, char** argv) {
       "Steps a jello world headless and prints a summary: steps, simulated and wall time, "
       "steps/s, real-time factor, energy at start and end, and the solver's statistics. For "
       "cvode, --dt is the output interval; CVODE chooses its own internal steps.\n"
-      "Exit codes: 0 done, 1 bad world file or I/O failure, 2 bad usage, 3 diverged.",
+      "Exit codes: 0 done, 1 bad world file or I/O failure, 2 bad usage, 3 diverged, "
+      "128+N interrupted by signal N (Ctrl-C: 130; trace and stats are written, --out is not).",
       "jello-sim"};
   app.add_option("world", opt.world, "World file (.w)")->required();
   app.add_option("--integrator", opt.integrator,
@@ -207,6 +230,16 @@ int main(int argc, char** argv) {
       ->needs(trace);
   app.add_option("--stats", opt.stats, "Write the summary as JSON");
   app.add_flag("--quiet,-q", opt.quiet, "Print nothing but errors");
+  app.add_option("--max-field-resolution", opt.limits.maxFieldResolution,
+                 "Refuse worlds with a larger force field (nodes per axis)")
+      ->check(CLI::Range(2, 1024))
+      ->capture_default_str()
+      ->group("Limits (checked before memory is allocated)");
+  app.add_option("--max-cube-resolution", opt.limits.maxCubeResolution,
+                 "Refuse worlds with a larger cube (points per axis)")
+      ->check(CLI::Range(2, 256))
+      ->capture_default_str()
+      ->group("Limits (checked before memory is allocated)");
 
   auto& implicit = opt.solver.implicit;
   auto& cvode = opt.solver.cvode;

@@ -111,6 +111,32 @@ TEST(JelloSim, ImplicitIntegratorsRunTheStiffSceneThatExplicitOnesCannot) {
   EXPECT_LE(cj["solver"]["last_order"].get<double>(), 2.0);
 }
 
+TEST(JelloSim, StopsCleanlyOnSigintAndWritesNoWorld) {
+  test::TempDir dir;
+  const auto out = dir.path() / "out.w", stats = dir.path() / "s.json",
+             trace = dir.path() / "t.csv";
+  const Outcome r = run("timeout --preserve-status -s INT 1 " + sim() + " " +
+                        world("skewedCorner.w") + " --time 100 --out " + out.string() +
+                        " --stats " + stats.string() + " --trace " + trace.string());
+  EXPECT_EQ(r.code, 130) << r.output;
+  EXPECT_TRUE(contains(r.output, "interrupted (signal 2) at t = ")) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  const auto json = nlohmann::json::parse(test::readFile(stats));
+  EXPECT_EQ(json["interrupted"], true);
+  EXPECT_GT(json["steps"].get<long>(), 0);
+  // The trace ends with a complete row at or before the step where it stopped.
+  const std::string csv = test::readFile(trace);
+  EXPECT_EQ(csv.back(), '\n');
+}
+
+TEST(JelloSim, RefusesWorldsOverItsLimits) {
+  const Outcome r = run(sim() + " " + world("jello.w") + " --max-field-resolution 16");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_TRUE(contains(r.output, "jello.w:7: force-field resolution must be 0 (none) or "
+                                 "between 2 and 16 (at '30')"))
+      << r.output;
+}
+
 TEST(JelloSim, RefusesABadWorldNamingFileAndLine) {
   test::TempDir dir;
   const auto bad = dir.path() / "bad.w";

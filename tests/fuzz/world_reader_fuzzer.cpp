@@ -1,0 +1,29 @@
+// libFuzzer target for the world reader, extension block included. Built and run by
+// scripts/fuzz.sh with clang 14 under AddressSanitizer and UndefinedBehaviorSanitizer.
+// Contract: any input either parses into a consistent world or throws WorldFileError.
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <string_view>
+
+#include "world_reader.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  // Small limits keep each input's allocations small; the limits themselves are tested.
+  jello::ReaderLimits limits;
+  limits.maxFieldResolution = 12;
+  limits.maxCubeResolution = 6;
+  try {
+    const jello::World w =
+        jello::parseWorld(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz",
+                          limits);
+    const std::size_t n = static_cast<std::size_t>(w.numPoints());
+    const std::size_t r = static_cast<std::size_t>(w.field.resolution);
+    if (w.positions.size() != n || w.velocities.size() != n || w.field.forces.size() != r * r * r ||
+        !(w.dt > 0.0) || !(w.mass > 0.0) || w.stepsPerFrame < 1) {
+      std::abort();  // accepted an inconsistent world
+    }
+  } catch (const jello::WorldFileError&) {
+  }
+  return 0;
+}
