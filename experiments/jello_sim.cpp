@@ -102,8 +102,12 @@ int run(const Options& opt) {
   }
   Simulation sim(std::move(world), kind, opt.dt, opt.solver);
   const double dt = sim.dt();
-  const long total = opt.steps ? *opt.steps
-                               : static_cast<long>(std::ceil(opt.time.value_or(1.0) / dt - 1e-9));
+  const double wanted = opt.steps ? double(*opt.steps) : std::ceil(opt.time.value_or(1.0) / dt - 1e-9);
+  if (!(wanted <= 1e12)) {  // also catches an overflowing quotient before the cast to long
+    std::fprintf(stderr, "jello-sim: error: %.3g steps asked for; at most 1e12 per run\n", wanted);
+    return kExitUsage;
+  }
+  const long total = static_cast<long>(wanted);
   const Energy start = sim.model().energy(sim.state());
   const std::string name(jello::integratorName(sim.integrator()));
 

@@ -9,9 +9,13 @@
 namespace jello {
 namespace {
 
-// Cell index and fraction along one axis for a coordinate clamped to the box.
+// Cell index and fraction along one axis for a coordinate clamped to the box. A NaN clamps to
+// -2 (std::clamp would keep it, and casting it to int is undefined): a diverging state then
+// reads a valid node, and the NaN reaches the divergence check through the other forces.
 void locate(double coord, int res, int& cell, double& frac) {
-  const double clamped = std::clamp(coord, -kBoxHalfSize, kBoxHalfSize);
+  const double clamped = coord > kBoxHalfSize     ? kBoxHalfSize
+                         : coord >= -kBoxHalfSize ? coord
+                                                  : -kBoxHalfSize;
   const double s = (clamped + kBoxHalfSize) / (2.0 * kBoxHalfSize) * (res - 1);
   cell = std::min(static_cast<int>(s), res - 2);
   frac = s - cell;

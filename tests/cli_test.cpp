@@ -151,6 +151,7 @@ TEST(JelloSim, AnswersBadUsageWithExitCodeTwo) {
   EXPECT_EQ(run(sim()).code, 2);
   EXPECT_EQ(run(sim() + " " + world("jello.w") + " --integrator verlet").code, 2);
   EXPECT_EQ(run(sim() + " " + world("jello.w") + " --dt -1").code, 2);
+  EXPECT_EQ(run(sim() + " " + world("jello.w") + " --time 1e300 --dt 1e-9").code, 2);
   const Outcome help = run(sim() + " --help");
   EXPECT_EQ(help.code, 0);
   EXPECT_TRUE(contains(help.output, "--integrator")) << help.output;

@@ -1,6 +1,7 @@
 // Trilinear interpolation of the force field.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 #include "force_field.h"
@@ -62,6 +63,17 @@ TEST(FieldForces, ClampsPointsOutsideTheBoxToItsSurface) {
   const FieldForces field(sampled(4, affine));
   expectNear(field.sample({3.0, -5.0, 0.5}), affine({2.0, -2.0, 0.5}), 1e-13);
   expectNear(field.sample({-2.5, 0.1, 9.0}), affine({-2.0, 0.1, 2.0}), 1e-13);
+}
+
+TEST(FieldForces, ANonFinitePositionReadsTheBoxInsteadOfCrashing) {
+  const FieldForces field(sampled(4, affine));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  expectNear(field.sample({nan, 0.5, -inf}), affine({-2.0, 0.5, -2.0}), 1e-13);
+  expectNear(field.sample({inf, nan, nan}), affine({2.0, -2.0, -2.0}), 1e-13);
+  double gradient[3][3];
+  field.gradient({nan, nan, nan}, gradient);
+  EXPECT_TRUE(std::isfinite(gradient[0][0]));
 }
 
 TEST(FieldForces, RecognizesUniformAndZeroFields) {
