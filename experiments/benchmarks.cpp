@@ -74,10 +74,11 @@ std::string loadedBlas() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // One BLAS thread, and no idle OpenMP threads spinning on the benchmark's core.
-  jello::applyRuntimeEnvironment(argv, /*pinBlas=*/true);
+  // Single-threaded BLAS and CHOLMOD (see runtime_environment.h).
+  jello::applyRuntimeEnvironment(argv);
   benchmark::AddCustomContext("blas", loadedBlas());
   benchmark::AddCustomContext("OPENBLAS_NUM_THREADS", std::getenv("OPENBLAS_NUM_THREADS"));
+  benchmark::AddCustomContext("OMP_THREAD_LIMIT", std::getenv("OMP_THREAD_LIMIT"));
   benchmark::AddCustomContext("OMP_WAIT_POLICY", std::getenv("OMP_WAIT_POLICY"));
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

@@ -205,7 +205,7 @@ int run(const Options& opt) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  jello::applyRuntimeEnvironment(argv, /*pinBlas=*/false);
+  jello::applyRuntimeEnvironment(argv);
   Options opt;
   CLI::App app{
       "Steps a jello world headless and prints a summary: steps, simulated and wall time, "

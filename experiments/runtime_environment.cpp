@@ -3,17 +3,16 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <initializer_list>
 
 namespace jello {
 
-void applyRuntimeEnvironment(char** argv, bool pinBlas) {
+void applyRuntimeEnvironment(char** argv) {
   bool changed = false;
-  if (!std::getenv("OMP_WAIT_POLICY")) {
-    changed |= ::setenv("OMP_WAIT_POLICY", "passive", 0) == 0;
+  for (const char* name : {"OMP_THREAD_LIMIT", "OPENBLAS_NUM_THREADS"}) {
+    if (!std::getenv(name)) changed |= ::setenv(name, "1", 0) == 0;
   }
-  if (pinBlas && !std::getenv("OPENBLAS_NUM_THREADS")) {
-    changed |= ::setenv("OPENBLAS_NUM_THREADS", "1", 0) == 0;
-  }
+  if (!std::getenv("OMP_WAIT_POLICY")) changed |= ::setenv("OMP_WAIT_POLICY", "passive", 0) == 0;
   if (changed) ::execv("/proc/self/exe", argv);  // returns only on failure: run as we are
 }
 

@@ -97,6 +97,17 @@ bool Model::contactBegins(const double* x0, const double* x1) const {
   return false;
 }
 
+double Model::fieldWork(const double* x0, const double* x1) const {
+  if (!field_) return 0.0;
+  const int n = n_;
+  double work = 0.0;
+  for (int p = 0; p < n; ++p) {
+    const Vec3 a{x0[p], x0[n + p], x0[2 * n + p]}, b{x1[p], x1[n + p], x1[2 * n + p]};
+    work += 0.5 * dot(field_->sample(a) + field_->sample(b), b - a);
+  }
+  return work;
+}
+
 Energy Model::energy(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const {
   Energy e;
   e.kinetic = 0.5 * mass_ * v.squaredNorm();

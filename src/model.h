@@ -71,6 +71,11 @@ class Model {
   // but was not at x0: the contact set changed between them.
   bool contactBegins(const double* x0, const double* x1) const;
 
+  // Work (J) the force field does on the points moving from x0 to x1 (3n each), by the
+  // trapezoid rule along the straight path: sum of 1/2 (F(x0) + F(x1)) . (x1 - x0). Exact for
+  // a uniform field; 0 without a field.
+  double fieldWork(const double* x0, const double* x1) const;
+
   Energy energy(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const;
   Energy energy(const State& s) const { return energy(s.x, s.v); }
 
