@@ -11,9 +11,9 @@
 #include <string>
 
 #include "runtime_environment.h"
+#include "scene_builder.h"
 #include "simulation.h"
 #include "world_reader.h"
-#include "scene_builder.h"
 
 namespace {
 

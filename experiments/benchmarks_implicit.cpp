@@ -110,9 +110,13 @@ void BM_ImplicitStep(benchmark::State& st, LinearSolverKind kind) {
   st.SetItemsProcessed(st.iterations());
 }
 BENCHMARK_CAPTURE(BM_ImplicitStep, cholmod, LinearSolverKind::Cholmod)
-    ->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond);
+    ->Arg(8)
+    ->Arg(16)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_ImplicitStep, cg, LinearSolverKind::Cg)
-    ->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond);
+    ->Arg(8)
+    ->Arg(16)
+    ->Unit(benchmark::kMillisecond);
 
 // Runs `sim` to t = 1 s; false if it diverged.
 bool runOneSecond(Simulation& sim) {
@@ -134,13 +138,17 @@ void BM_CvodeOneSecond(benchmark::State& st, double rtol, LinearSolverKind kind)
   }
 }
 BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e3_cholmod, 1e-3, LinearSolverKind::Cholmod)
-    ->Iterations(1)->Unit(benchmark::kSecond);
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e3_cg, 1e-3, LinearSolverKind::Cg)
-    ->Iterations(1)->Unit(benchmark::kSecond);
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e6_cholmod, 1e-6, LinearSolverKind::Cholmod)
-    ->Iterations(1)->Unit(benchmark::kSecond);
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e6_cg, 1e-6, LinearSolverKind::Cg)
-    ->Iterations(1)->Unit(benchmark::kSecond);
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
 
 // The largest dt at which RK4 runs the stiff cube for 0.1 s without diverging (bisection to
 // 1%), then 5% below it for safety over the full second.
@@ -169,12 +177,21 @@ void BM_StiffOneSecond(benchmark::State& st, IntegratorKind kind, LinearSolverKi
 }
 BENCHMARK_CAPTURE(BM_StiffOneSecond, rk4_at_its_limit, IntegratorKind::RK4,
                   LinearSolverKind::Cholmod)
-    ->Arg(5)->Arg(6)->Iterations(3)->Unit(benchmark::kMillisecond);
+    ->Arg(5)
+    ->Arg(6)
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_StiffOneSecond, implicit_cholmod_dt001, IntegratorKind::Implicit,
                   LinearSolverKind::Cholmod)
-    ->Arg(5)->Arg(6)->Iterations(3)->Unit(benchmark::kMillisecond);
+    ->Arg(5)
+    ->Arg(6)
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_StiffOneSecond, implicit_cg_dt001, IntegratorKind::Implicit,
                   LinearSolverKind::Cg)
-    ->Arg(5)->Arg(6)->Iterations(3)->Unit(benchmark::kMillisecond);
+    ->Arg(5)
+    ->Arg(6)
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -1,13 +1,13 @@
 // jello-create-world: writes a world file. With no arguments it writes ./jello.w with the
 // original course creator's values (reference-worlds/createWorld-default.w); flags set every
 // field. The file is checked by reading it back before it replaces anything on disk.
+#include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 #include <map>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 #include "atomic_file.h"
 #include "scene_builder.h"
@@ -20,11 +20,14 @@ using jello::FieldPreset;
 using jello::PosePreset;
 using jello::Vec3;
 
-Vec3 toVec3(const std::vector<double>& v) { return {v[0], v[1], v[2]}; }
+Vec3 toVec3(const std::vector<double>& v) {
+  return {v[0], v[1], v[2]};
+}
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit fails the write (reported), not the process
   jello::SceneSpec spec;
   std::string out = "jello.w";
   std::string integrator = "rk4";
@@ -40,7 +43,9 @@ int main(int argc, char** argv) {
   app.add_option("-o,--output", out, "File to write (default jello.w)");
   app.add_option("--integrator", integrator, "Integrator: " + jello::integratorNameList())
       ->capture_default_str();
-  app.add_option("--dt", spec.dt, "Time step, s")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--dt", spec.dt, "Time step, s")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("-n,--steps-per-frame", spec.stepsPerFrame, "Steps per drawn frame")
       ->check(CLI::Range(1, 1000000))
       ->capture_default_str();
@@ -58,8 +63,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--mass", spec.mass, "Mass of each point, kg (default 1/512)")
       ->check(CLI::PositiveNumber);
-  auto* planeOpt = app.add_option("--plane", plane, "Inclined plane A B C D: Ax+By+Cz+D=0, "
-                                                    "free where positive (default -1 1 1 2)")
+  auto* planeOpt = app.add_option("--plane", plane,
+                                  "Inclined plane A B C D: Ax+By+Cz+D=0, "
+                                  "free where positive (default -1 1 1 2)")
                        ->expected(4);
   app.add_flag("--no-plane", noPlane, "No inclined plane")->excludes(planeOpt);
 
@@ -97,11 +103,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--axis", axis, "Rotation axis X Y Z for --pose rotated (default 1 1 1)")
       ->expected(3);
-  app.add_option("--translate", translate, "Offset X Y Z, m, for --pose translated "
-                                           "(default 0.5 0.5 0.5)")
+  app.add_option("--translate", translate,
+                 "Offset X Y Z, m, for --pose translated "
+                 "(default 0.5 0.5 0.5)")
       ->expected(3);
-  app.add_option("--velocity", velocity, "Uniform initial velocity VX VY VZ, m/s "
-                                         "(default 10 -10 20)")
+  app.add_option("--velocity", velocity,
+                 "Uniform initial velocity VX VY VZ, m/s "
+                 "(default 10 -10 20)")
       ->expected(3);
   app.add_option("--spin", spec.spin,
                  "Initial spin about the vertical axis through the cube's centre, rad/s");
@@ -154,8 +162,8 @@ int main(int argc, char** argv) {
   }
   std::printf("wrote %s (%d points%s%s, field %s)\n", out.c_str(), world.numPoints(),
               world.plane ? ", plane" : "", world.sphere ? ", sphere" : "",
-              world.field.resolution ? (field + " at " + std::to_string(world.field.resolution) +
-                                        "^3 nodes").c_str()
-                                     : "none");
+              world.field.resolution
+                  ? (field + " at " + std::to_string(world.field.resolution) + "^3 nodes").c_str()
+                  : "none");
   return 0;
 }

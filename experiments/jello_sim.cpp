@@ -3,16 +3,15 @@
 //             [--out FILE.w] [--trace FILE.csv --every K] [--stats FILE.json] [--quiet]
 // Exit codes: 0 done, 1 bad input or an I/O failure, 2 bad usage, 3 the simulation diverged,
 // 128 + signal when interrupted by SIGINT or SIGTERM (it stops at a step boundary).
+#include <CLI/CLI.hpp>
 #include <chrono>
-#include <csignal>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <string>
-
-#include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include "atomic_file.h"
 #include "progress.h"
@@ -33,7 +32,9 @@ constexpr int kExitDiverged = 3;
 
 volatile std::sig_atomic_t interruptSignal = 0;
 
-extern "C" void onInterrupt(int signo) { interruptSignal = signo; }
+extern "C" void onInterrupt(int signo) {
+  interruptSignal = signo;
+}
 
 struct Options {
   std::string world;
@@ -70,8 +71,8 @@ class Trace {
     const Eigen::Index n = s.numPoints();
     char buf[320];
     std::snprintf(buf, sizeof buf, "%ld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
-                  sim.steps(), s.t, e.kinetic, e.spring, e.contact, e.total(),
-                  s.x.head(n).mean(), s.x.segment(n, n).mean(), s.x.tail(n).mean());
+                  sim.steps(), s.t, e.kinetic, e.spring, e.contact, e.total(), s.x.head(n).mean(),
+                  s.x.segment(n, n).mean(), s.x.tail(n).mean());
     csv_ << buf;
   }
   std::string text() const { return csv_.str(); }
@@ -102,7 +103,8 @@ int run(const Options& opt) {
   }
   Simulation sim(std::move(world), kind, opt.dt, opt.solver);
   const double dt = sim.dt();
-  const double wanted = opt.steps ? double(*opt.steps) : std::ceil(opt.time.value_or(1.0) / dt - 1e-9);
+  const double wanted =
+      opt.steps ? double(*opt.steps) : std::ceil(opt.time.value_or(1.0) / dt - 1e-9);
   if (!(wanted <= 1e12)) {  // also catches an overflowing quotient before the cast to long
     std::fprintf(stderr, "jello-sim: error: %.3g steps asked for; at most 1e12 per run\n", wanted);
     return kExitUsage;
@@ -168,7 +170,9 @@ int run(const Options& opt) {
                 sim.model().springs().numSprings());
     std::printf("integrator   %s, dt = %g s\n", name.c_str(), dt);
     std::printf("steps        %ld%s\n", done,
-                diverged ? " (then diverged)" : interrupted ? " (interrupted)" : "");
+                diverged      ? " (then diverged)"
+                : interrupted ? " (interrupted)"
+                              : "");
     std::printf("simulated    %.6g s\n", s.t);
     std::printf("wall time    %.3f s (%.0f steps/s, %.2fx real time)\n", wall,
                 wall > 0 ? double(done) / wall : 0.0, wall > 0 ? s.t / wall : 0.0);
@@ -206,6 +210,9 @@ int run(const Options& opt) {
 
 int main(int argc, char** argv) {
   jello::applyRuntimeEnvironment(argv);
+  // A file-size limit (or a quota) must fail the write, which is reported and cleaned up, not
+  // kill the process with a temporary file left behind.
+  std::signal(SIGXFSZ, SIG_IGN);
   Options opt;
   CLI::App app{
       "Steps a jello world headless and prints a summary: steps, simulated and wall time, "
@@ -224,8 +231,7 @@ int main(int argc, char** argv) {
   app.add_option("--steps", opt.steps, "Number of steps to run instead of --time")
       ->check(CLI::NonNegativeNumber)
       ->excludes(time);
-  app.add_option("--cube", opt.cube,
-                 "Resample the cube to N^3 points (initial state interpolated)")
+  app.add_option("--cube", opt.cube, "Resample the cube to N^3 points (initial state interpolated)")
       ->check(CLI::Range(2, 64));
   app.add_option("--out", opt.out, "Write the final state as a world file");
   auto* trace = app.add_option("--trace", opt.trace, "Write energies and centre of mass (CSV)");

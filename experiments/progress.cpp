@@ -22,9 +22,8 @@ void Progress::draw(long done, long total) {
   last_ = now;
   const double fraction = total > 0 ? double(done) / double(total) : 0.0;
   const double eta = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
-  std::fprintf(stderr, "%s[%3.0f%%] %ld/%ld %s, %.0f s elapsed, %.0f s left%s",
-               tty_ ? "\r" : "", 100.0 * fraction, done, total, label_.c_str(), elapsed, eta,
-               tty_ ? "\033[K" : "\n");
+  std::fprintf(stderr, "%s[%3.0f%%] %ld/%ld %s, %.0f s elapsed, %.0f s left%s", tty_ ? "\r" : "",
+               100.0 * fraction, done, total, label_.c_str(), elapsed, eta, tty_ ? "\033[K" : "\n");
   std::fflush(stderr);
   drawn_ = true;
 }

@@ -20,12 +20,11 @@ void BackwardEuler::prepare(const Model& model) {
 void BackwardEuler::assemble(const double* x, const double* v) {
   const auto start = std::chrono::steady_clock::now();
   jacobian_->assemble(x, v, {options_.clampCompression, false});
-  assembleSeconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-                          .count();
+  assembleSeconds_ +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-StepResult BackwardEuler::factorAndSolve(double h, const Eigen::VectorXd& rhs,
-                                         Eigen::VectorXd& x) {
+StepResult BackwardEuler::factorAndSolve(double h, const Eigen::VectorXd& rhs, Eigen::VectorXd& x) {
   jacobian_->combine(h, h * h, A_);
   if (StepResult r = solver_.factorize(A_); !r.ok) return r;
   return solver_.solve(rhs, x);

@@ -10,7 +10,9 @@
 namespace jello {
 namespace {
 
-CvodeIntegrator& self(void* data) { return *static_cast<CvodeIntegrator*>(data); }
+CvodeIntegrator& self(void* data) {
+  return *static_cast<CvodeIntegrator*>(data);
+}
 
 int rhsTrampoline(sunrealtype, N_Vector y, N_Vector ydot, void* data) {
   return self(data).rightHandSide(N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
@@ -26,9 +28,15 @@ int linsysTrampoline(sunrealtype, N_Vector y, N_Vector, SUNMatrix, sunbooleantyp
 }
 
 // The custom linear solver: its content is the integrator, which SUNDIALS must never free.
-SUNLinearSolver_Type lsType(SUNLinearSolver) { return SUNLINEARSOLVER_DIRECT; }
-SUNLinearSolver_ID lsId(SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; }
-int lsSetup(SUNLinearSolver s, SUNMatrix) { return self(s->content).setupSolver(); }
+SUNLinearSolver_Type lsType(SUNLinearSolver) {
+  return SUNLINEARSOLVER_DIRECT;
+}
+SUNLinearSolver_ID lsId(SUNLinearSolver) {
+  return SUNLINEARSOLVER_CUSTOM;
+}
+int lsSetup(SUNLinearSolver s, SUNMatrix) {
+  return self(s->content).setupSolver();
+}
 int lsSolve(SUNLinearSolver s, SUNMatrix, N_Vector x, N_Vector b, sunrealtype) {
   return self(s->content).solve(N_VGetArrayPointer(b), N_VGetArrayPointer(x));
 }
@@ -39,8 +47,12 @@ int lsFree(SUNLinearSolver s) {
 }
 
 // The matrix CVODE hands around is a placeholder: the system lives in the integrator.
-SUNMatrix_ID matId(SUNMatrix) { return SUNMATRIX_CUSTOM; }
-void matDestroy(SUNMatrix m) { SUNMatFreeEmpty(m); }
+SUNMatrix_ID matId(SUNMatrix) {
+  return SUNMATRIX_CUSTOM;
+}
+void matDestroy(SUNMatrix m) {
+  SUNMatFreeEmpty(m);
+}
 
 std::string cvodeError(const char* call, int flag) {
   const char* name = CVodeGetReturnFlagName(flag);
@@ -178,7 +190,9 @@ int CvodeIntegrator::linearSystem(const double* y, bool jacobianOk, bool* jacobi
   return 0;
 }
 
-int CvodeIntegrator::setupSolver() { return solver_->factorize(A_).ok ? 0 : 1; }
+int CvodeIntegrator::setupSolver() {
+  return solver_->factorize(A_).ok ? 0 : 1;
+}
 
 int CvodeIntegrator::solve(const double* b, double* x) {
   const Eigen::Map<const Eigen::VectorXd> r1(b, n3_), r2(b + n3_, n3_);

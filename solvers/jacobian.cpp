@@ -66,8 +66,7 @@ JacobianAssembler::JacobianAssembler(const Model& model) : model_(model) {
   for (int i = 0; i < 3 * n; ++i) diagonal_.push_back(slotOf(K_, i, i));
 }
 
-void JacobianAssembler::assemble(const double* x, const double* v,
-                                 const JacobianOptions& options) {
+void JacobianAssembler::assemble(const double* x, const double* v, const JacobianOptions& options) {
   (void)v;  // D does not depend on v: the forces are linear in v
   const int n = model_.numPoints();
   double* Kv = K_.valuePtr();
@@ -105,7 +104,7 @@ void JacobianAssembler::assemble(const double* x, const double* v,
         Kb[e] += Ke;
         Da[e] += De;
         Db[e] += De;
-        Kv[slot[e]] = -Ke;  // (a,b)
+        Kv[slot[e]] = -Ke;      // (a,b)
         Kv[slot[9 + e]] = -Ke;  // (b,a)
         Dv[slot[e]] = -De;
         Dv[slot[9 + e]] = -De;

@@ -16,9 +16,8 @@
 // Force field (optional, off for the implicit solvers): K += dF/dx, the trilinear gradient.
 #pragma once
 
-#include <vector>
-
 #include <Eigen/SparseCore>
+#include <vector>
 
 #include "model.h"
 
@@ -54,10 +53,10 @@ class JacobianAssembler {
   std::vector<Spring> springs_;
   std::vector<double> stiffness_, damping_;  // per spring
   SparseMatrix K_, D_;
-  std::vector<int> springSlots_;  // 18 per spring: value index of blocks (a,b), (b,a)
-  std::vector<int> diagSlots_;    // 9 per point: value index of its diagonal block
+  std::vector<int> springSlots_;       // 18 per spring: value index of blocks (a,b), (b,a)
+  std::vector<int> diagSlots_;         // 9 per point: value index of its diagonal block
   std::vector<double> diagK_, diagD_;  // 9 per point: diagonal blocks gathered densely
-  std::vector<int> diagonal_;     // value index of each diagonal entry (for the mass)
+  std::vector<int> diagonal_;          // value index of each diagonal entry (for the mass)
   long lastClamps_ = 0, totalClamps_ = 0;
 };
 

@@ -1,9 +1,8 @@
 #include "linear_solver.h"
 
-#include <chrono>
-
 #include <Eigen/CholmodSupport>
 #include <Eigen/IterativeLinearSolvers>
+#include <chrono>
 
 namespace jello {
 namespace {
@@ -26,7 +25,7 @@ struct SpdSolver::Impl {
       cg;
   bool lltAnalyzed = false;
   bool ldltAnalyzed = false;
-  bool useLdlt = false;           // this factorization went to LDLT
+  bool useLdlt = false;             // this factorization went to LDLT
   const SparseMatrix* A = nullptr;  // for the residual check
 
   Impl() {

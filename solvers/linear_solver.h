@@ -9,12 +9,11 @@
 //   cg       conjugate gradients with a Jacobi preconditioner, warm-started from x.
 #pragma once
 
+#include <Eigen/Core>
 #include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
-
-#include <Eigen/Core>
 
 #include "jacobian.h"
 #include "step_result.h"

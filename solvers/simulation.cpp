@@ -52,7 +52,9 @@ void Simulation::setIntegrator(IntegratorKind kind) {
   if (kind != integrator_->kind()) integrator_ = makeIntegrator(kind, options_);
 }
 
-void Simulation::setTimeStep(double dt) { dt_ = dt; }
+void Simulation::setTimeStep(double dt) {
+  dt_ = dt;
+}
 
 World Simulation::currentWorld() const {
   World w = world_;

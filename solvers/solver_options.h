@@ -7,20 +7,21 @@ namespace jello {
 
 struct ImplicitOptions {
   LinearSolverKind linearSolver = LinearSolverKind::Cholmod;
-  int newtonIterations = 1;        // 1: the linearized step of Baraff & Witkin
+  int newtonIterations = 1;  // 1: the linearized step of Baraff & Witkin
   // A step during which a contact begins is not near its linearization (the penalty spring
   // was not in the matrix): it gets up to this many Newton iterations whatever the above.
   int contactNewtonIterations = 4;
-  double contactNewtonTolerance = 1e-4;  // their relative residual: the penalty must act, that's all
-  double newtonTolerance = 1e-8;   // relative residual that ends the Newton iterations
-  bool clampCompression = true;    // project each spring's Hessian onto semidefinite matrices
-  double cgTolerance = 1e-6;       // relative residual of the CG solves
+  double contactNewtonTolerance =
+      1e-4;                       // their relative residual: the penalty must act, that's all
+  double newtonTolerance = 1e-8;  // relative residual that ends the Newton iterations
+  bool clampCompression = true;   // project each spring's Hessian onto semidefinite matrices
+  double cgTolerance = 1e-6;      // relative residual of the CG solves
 };
 
 struct CvodeOptions {
   double rtol = 1e-6;
-  double atol = 0.0;               // 0: 1e-3 * rtol (positions in m, velocities in m/s)
-  int maxOrder = 5;                // BDF order limit, 1..5 (3..5 are not A-stable)
+  double atol = 0.0;  // 0: 1e-3 * rtol (positions in m, velocities in m/s)
+  int maxOrder = 5;   // BDF order limit, 1..5 (3..5 are not A-stable)
   bool stabilityLimitDetection = true;
   double maxStep = 0.0;            // s, 0: no limit
   long maxStepsPerCall = 1000000;  // internal steps CVODE may take to reach one output time

@@ -20,9 +20,7 @@ namespace {
 // Closes and removes the temporary file unless it was renamed into place.
 class TempFile {
  public:
-  explicit TempFile(std::string name) : name_(std::move(name)) {
-    fd_ = ::mkstemp(name_.data());
-  }
+  explicit TempFile(std::string name) : name_(std::move(name)) { fd_ = ::mkstemp(name_.data()); }
   ~TempFile() {
     if (fd_ >= 0) ::close(fd_);
     if (!committed_) ::unlink(name_.c_str());

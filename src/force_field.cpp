@@ -72,9 +72,8 @@ void FieldForces::gradient(const Vec3& position, double out[3][3]) const {
           const bool clamped = p[b] < -kBoxHalfSize || p[b] > kBoxHalfSize;
           dw[b] = clamped ? 0.0 : (corner[b] ? perMetre : -perMetre);
         }
-        const Vec3& F =
-            field_.forces[static_cast<std::size_t>(((cell[0] + di) * r + (cell[1] + dj)) * r +
-                                                   (cell[2] + dk))];
+        const Vec3& F = field_.forces[static_cast<std::size_t>(
+            ((cell[0] + di) * r + (cell[1] + dj)) * r + (cell[2] + dk))];
         const double grad[3] = {dw[0] * w[1] * w[2], w[0] * dw[1] * w[2], w[0] * w[1] * dw[2]};
         for (int b = 0; b < 3; ++b) {
           out[0][b] += F.x * grad[b];

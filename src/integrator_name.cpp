@@ -46,11 +46,17 @@ std::optional<IntegratorKind> parseIntegratorName(std::string_view name) {
   return std::nullopt;
 }
 
-std::string_view integratorName(IntegratorKind kind) { return entry(kind).name; }
+std::string_view integratorName(IntegratorKind kind) {
+  return entry(kind).name;
+}
 
-std::string_view integratorFileName(IntegratorKind kind) { return entry(kind).fileName; }
+std::string_view integratorFileName(IntegratorKind kind) {
+  return entry(kind).fileName;
+}
 
-std::span<const IntegratorKind> allIntegrators() { return kKinds; }
+std::span<const IntegratorKind> allIntegrators() {
+  return kKinds;
+}
 
 std::string integratorNameList() {
   std::string list;

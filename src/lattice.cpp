@@ -38,7 +38,9 @@ const char* springKindName(SpringKind kind) {
   return "?";
 }
 
-std::span<const LatticeOffset> latticeOffsets() { return kOffsets; }
+std::span<const LatticeOffset> latticeOffsets() {
+  return kOffsets;
+}
 
 std::array<long, kSpringKinds> springCountFormula(int n) {
   const long N = n;

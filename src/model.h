@@ -6,10 +6,9 @@
 // integrators use: forces/acceleration of a state, and its energy.
 #pragma once
 
+#include <Eigen/Core>
 #include <optional>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "contact.h"
 #include "force_field.h"
@@ -64,8 +63,7 @@ class Model {
   void acceleration(const double* x, const double* v, double* a) const;
   // The same on Eigen vectors; the output is resized.
   void forces(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& f) const;
-  void acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
-                    Eigen::VectorXd& a) const;
+  void acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& a) const;
 
   // True when some point is in contact (with a wall, the plane or the sphere) at positions x1
   // but was not at x0: the contact set changed between them.

@@ -26,8 +26,8 @@ Vec3 posed(const SceneSpec& spec, Vec3 rest) {
     case PosePreset::Stretched:
       return {centre.x + (rest.x - centre.x) * spec.stretch, rest.y, rest.z};
     case PosePreset::Rotated:
-      return centre + rotate(rest - centre, spec.rotateAxis, spec.rotateDegrees *
-                                                                std::numbers::pi / 180.0);
+      return centre +
+             rotate(rest - centre, spec.rotateAxis, spec.rotateDegrees * std::numbers::pi / 180.0);
     case PosePreset::Translated:
       return rest + spec.translate;
   }
@@ -138,8 +138,7 @@ World resampleCube(const World& world, int n) {
     for (int di = 0; di < 2; ++di)
       for (int dj = 0; dj < 2; ++dj)
         for (int dk = 0; dk < 2; ++dk) {
-          const double wgt =
-              (di ? fi : 1 - fi) * (dj ? fj : 1 - fj) * (dk ? fk : 1 - fk);
+          const double wgt = (di ? fi : 1 - fi) * (dj ? fj : 1 - fj) * (dk ? fk : 1 - fk);
           sum += values[from.index(i + di, j + dj, k + dk)] * wgt;
         }
     return sum;

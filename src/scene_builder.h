@@ -36,10 +36,10 @@ struct SceneSpec {
   int fieldResolution = 30;    // 0 = no field
   int cubeResolution = kDefaultCubeResolution;
   PosePreset pose = PosePreset::SkewedCorner;
-  double stretch = 1.25;          // Stretched: factor along x
-  double rotateDegrees = 30.0;    // Rotated: angle, degrees
-  Vec3 rotateAxis{1.0, 1.0, 1.0}; // Rotated: axis (any length, not zero)
-  Vec3 translate{0.5, 0.5, 0.5};  // Translated: offset, m
+  double stretch = 1.25;             // Stretched: factor along x
+  double rotateDegrees = 30.0;       // Rotated: angle, degrees
+  Vec3 rotateAxis{1.0, 1.0, 1.0};    // Rotated: axis (any length, not zero)
+  Vec3 translate{0.5, 0.5, 0.5};     // Translated: offset, m
   Vec3 velocity{10.0, -10.0, 20.0};  // m/s, uniform
   double spin = 0.0;  // rad/s about the z axis through the cube's centre, added to velocity
   std::optional<Sphere> sphere;

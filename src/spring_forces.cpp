@@ -6,8 +6,7 @@
 
 namespace jello {
 
-std::vector<SpringGroup> latticeSpringGroups(const Lattice& lat, double stiffness,
-                                             double damping) {
+std::vector<SpringGroup> latticeSpringGroups(const Lattice& lat, double stiffness, double damping) {
   std::vector<SpringGroup> groups;
   const int n = lat.n;
   for (const LatticeOffset& o : latticeOffsets()) {
@@ -103,16 +102,16 @@ void accumulateGroup(const SpringGroup& g, std::ptrdiff_t count, const double* _
                      const double* __restrict zq, const double* __restrict vxp,
                      const double* __restrict vyp, const double* __restrict vzp,
                      const double* __restrict vxq, const double* __restrict vyq,
-                     const double* __restrict vzq, double* __restrict fxp,
-                     double* __restrict fyp, double* __restrict fzp, double* __restrict gx,
-                     double* __restrict gy, double* __restrict gz) {
+                     const double* __restrict vzq, double* __restrict fxp, double* __restrict fyp,
+                     double* __restrict fzp, double* __restrict gx, double* __restrict gy,
+                     double* __restrict gz) {
   const double k = g.stiffness, c = g.damping, L0 = g.rest;
   const double* __restrict mask = g.mask.data();
   // Pass 1: the force on each base point, added in place (base points run unit-stride).
   for (std::ptrdiff_t s = 0; s < count; ++s) {
     const double dx = xq[s] - xp[s], dy = yq[s] - yp[s], dz = zq[s] - zp[s];
-    const double scale = springScale(dx, dy, dz, vxq[s] - vxp[s], vyq[s] - vyp[s],
-                                     vzq[s] - vzp[s], k, c, L0, mask[s]);
+    const double scale = springScale(dx, dy, dz, vxq[s] - vxp[s], vyq[s] - vyp[s], vzq[s] - vzp[s],
+                                     k, c, L0, mask[s]);
     gx[s] = scale * dx;
     gy[s] = scale * dy;
     gz[s] = scale * dz;
@@ -125,8 +124,7 @@ void accumulateGroup(const SpringGroup& g, std::ptrdiff_t count, const double* _
 // Pass 2: the opposite force on the partners, in its own loop since q may alias p + 1.
 void subtractFromPartners(std::ptrdiff_t count, const double* __restrict gx,
                           const double* __restrict gy, const double* __restrict gz,
-                          double* __restrict fxq, double* __restrict fyq,
-                          double* __restrict fzq) {
+                          double* __restrict fxq, double* __restrict fyq, double* __restrict fzq) {
   for (std::ptrdiff_t s = 0; s < count; ++s) {
     fxq[s] -= gx[s];
     fyq[s] -= gy[s];

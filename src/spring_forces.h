@@ -16,12 +16,12 @@ namespace jello {
 
 struct SpringGroup {
   SpringKind kind = SpringKind::Structural;
-  int delta = 1;              // flat index offset from p to its partner
-  int first = 0;              // first base point
-  std::vector<double> mask;   // 1 where p -> p + delta is a spring, 0 where it is not
-  double rest = 0.0;          // m
-  double stiffness = 0.0;     // N/m
-  double damping = 0.0;       // N*s/m
+  int delta = 1;             // flat index offset from p to its partner
+  int first = 0;             // first base point
+  std::vector<double> mask;  // 1 where p -> p + delta is a spring, 0 where it is not
+  double rest = 0.0;         // m
+  double stiffness = 0.0;    // N/m
+  double damping = 0.0;      // N*s/m
   int numSprings = 0;
 };
 

@@ -35,8 +35,8 @@ inline constexpr int kDefaultCubeResolution = 8;  // the only one the original f
 
 struct World {
   IntegratorKind integrator = IntegratorKind::RK4;
-  double dt = 0.0005;     // s, time step
-  int stepsPerFrame = 1;  // n: integrator steps per drawn frame
+  double dt = 0.0005;       // s, time step
+  int stepsPerFrame = 1;    // n: integrator steps per drawn frame
   double kElastic = 0.0;    // N/m, structural, shear and bend springs
   double dElastic = 0.0;    // N*s/m, their damping along the spring
   double kCollision = 0.0;  // N/m, contact penalty springs (walls, plane, sphere)

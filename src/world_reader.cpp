@@ -106,7 +106,9 @@ class Tokenizer {
   Token lastToken_;
 };
 
-bool isExtensionKeyword(std::string_view s) { return s == "cube" || s == "sphere"; }
+bool isExtensionKeyword(std::string_view s) {
+  return s == "cube" || s == "sphere";
+}
 
 bool looksNumeric(std::string_view s) {
   const char c = s.front();
@@ -203,8 +205,8 @@ World parseWorld(std::string_view text, const std::string& name, const ReaderLim
     // Each of the 3*nodes numbers needs at least a digit and a separator: refuse before
     // allocating when the file cannot hold them.
     if (in.remainingBytes() + 1 < nodes * 3 * 2) {
-      in.fail(resToken, "file is too short for a force field of resolution " +
-                            std::to_string(res) + " (" + std::to_string(nodes) + " nodes)");
+      in.fail(resToken, "file is too short for a force field of resolution " + std::to_string(res) +
+                            " (" + std::to_string(nodes) + " nodes)");
     }
     w.field.resolution = res;
     w.field.forces.resize(nodes);
@@ -224,8 +226,9 @@ World parseWorld(std::string_view text, const std::string& name, const ReaderLim
   Token t = in.next();
   while (!t.text.empty() && !isExtensionKeyword(t.text)) {
     if (completeCube(values.size()) && !looksNumeric(t.text)) {
-      in.fail(t, "unknown trailing content after the velocities (extension keywords: cube, "
-                 "sphere)");
+      in.fail(t,
+              "unknown trailing content after the velocities (extension keywords: cube, "
+              "sphere)");
     }
     values.push_back(in.toNumber(t, "a position or velocity"));
     tokens.push_back(t);
@@ -240,9 +243,8 @@ World parseWorld(std::string_view text, const std::string& name, const ReaderLim
     const std::string block = inPositions ? "positions" : "velocities";
     const std::size_t got = inPositions ? values.size() : values.size() - 3 * points;
     const Token where{{}, tokens.empty() ? t.line : tokens.back().line};
-    in.fail(where, "truncated: " + std::to_string(got / 3) + " of " + std::to_string(points) +
-                       " " + block + " (cube resolution " +
-                       std::to_string(w.cubeResolution) + ")");
+    in.fail(where, "truncated: " + std::to_string(got / 3) + " of " + std::to_string(points) + " " +
+                       block + " (cube resolution " + std::to_string(w.cubeResolution) + ")");
   }
   if (values.size() > expected) {
     in.fail(tokens[expected], "unknown trailing content after the " + std::to_string(points) +

@@ -1,9 +1,10 @@
 // Backward Euler: its exact energy loss, order of convergence, Newton residual, linear solvers.
+#include "backward_euler.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "backward_euler.h"
 #include "explicit_integrators.h"
 #include "scene_builder.h"
 #include "test_support.h"
@@ -72,8 +73,8 @@ int expectExactBackwardEulerSteps(const SmallCube& cube, double tolerance) {
     Eigen::VectorXd f;
     cube.model.forces(s.x, s.v, f);
     const Eigen::VectorXd g = cube.model.mass() * (s.v - before.v) - h * f;
-    EXPECT_LE(g.norm(), 2 * tolerance * (cube.model.mass() * (s.v - before.v).norm() +
-                                         h * f.norm()));
+    EXPECT_LE(g.norm(),
+              2 * tolerance * (cube.model.mass() * (s.v - before.v).norm() + h * f.norm()));
     EXPECT_LE((s.x - before.x - h * s.v).cwiseAbs().maxCoeff(), 1e-15);
   }
   return most;

@@ -1,12 +1,12 @@
 // jello-sim and jello-create-world as a user runs them: exit codes, messages, files.
 #include <gtest/gtest.h>
-
 #include <sys/wait.h>
 
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "atomic_file.h"
 #include "scene_builder.h"
 #include "test_support.h"
 #include "world_reader.h"
@@ -30,9 +30,15 @@ Outcome run(const std::string& command) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
 }
 
-std::string sim() { return JELLO_SIM; }
-std::string create() { return JELLO_CREATE_WORLD; }
-std::string world(const char* name) { return (test::worldsDir() / name).string(); }
+std::string sim() {
+  return JELLO_SIM;
+}
+std::string create() {
+  return JELLO_CREATE_WORLD;
+}
+std::string world(const char* name) {
+  return (test::worldsDir() / name).string();
+}
 bool contains(const std::string& s, const std::string& part) {
   return s.find(part) != std::string::npos;
 }
@@ -50,9 +56,9 @@ TEST(JelloSim, WritesTheFinalStateStatsAndTrace) {
   test::TempDir dir;
   const auto out = dir.path() / "end.w", stats = dir.path() / "s.json",
              trace = dir.path() / "t.csv";
-  const Outcome r = run(sim() + " " + world("moveLeft.w") + " --time 0.05 --quiet --out " +
-                    out.string() + " --stats " + stats.string() + " --trace " + trace.string() +
-                    " --every 10");
+  const Outcome r =
+      run(sim() + " " + world("moveLeft.w") + " --time 0.05 --quiet --out " + out.string() +
+          " --stats " + stats.string() + " --trace " + trace.string() + " --every 10");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(r.output, "");
   const World end = readWorld(out);
@@ -78,8 +84,8 @@ TEST(JelloSim, ReportsDivergenceWithExitCodeThreeAndWritesNoWorld) {
   spec.dElastic = 0.0;
   const auto stiff = dir.path() / "stiff.w", out = dir.path() / "out.w";
   writeWorld(buildWorld(spec), stiff);
-  const Outcome r = run(sim() + " " + stiff.string() + " --integrator rk4 --dt 0.01 --out " +
-                    out.string());
+  const Outcome r =
+      run(sim() + " " + stiff.string() + " --integrator rk4 --dt 0.01 --out " + out.string());
   EXPECT_EQ(r.code, 3) << r.output;
   EXPECT_TRUE(contains(r.output, "diverged at t = ")) << r.output;
   EXPECT_TRUE(contains(r.output, "integrator rk4")) << r.output;
@@ -103,7 +109,8 @@ TEST(JelloSim, ImplicitIntegratorsRunTheStiffSceneThatExplicitOnesCannot) {
 
   const Outcome c = run(sim() + " " + stiff.string() +
                         " --integrator cvode --dt 0.01 --time 0.02 --rtol 1e-3 --max-order 2"
-                        " --linear-solver cg --stats " + stats.string());
+                        " --linear-solver cg --stats " +
+                        stats.string());
   ASSERT_EQ(c.code, 0) << c.output;
   const auto cj = nlohmann::json::parse(test::readFile(stats));
   EXPECT_EQ(cj["steps"], 2);  // output intervals
@@ -129,11 +136,39 @@ TEST(JelloSim, StopsCleanlyOnSigintAndWritesNoWorld) {
   EXPECT_EQ(csv.back(), '\n');
 }
 
+TEST(JelloSim, AFullDiskLeavesThePreviousFileIntactAndSaysSo) {
+  // ulimit -f makes every write past 4 kB fail with EFBIG, as a full disk fails with ENOSPC.
+  test::TempDir dir;
+  const auto out = dir.path() / "out.w";
+  writeFileAtomically(out, "previous contents\n");
+  const Outcome r = run("ulimit -f 4; " + sim() + " " + world("jello.w") + " --steps 10 -q --out " +
+                        out.string());
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "cannot write " + out.string() + ": write: File too large"))
+      << r.output;
+  EXPECT_EQ(test::readFile(out), "previous contents\n");
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()),
+                          std::filesystem::directory_iterator{}),
+            1);  // no temporary file left behind
+}
+
+TEST(JelloSim, ReportsADirectoryItCannotWriteInto) {
+  const Outcome missing =
+      run(sim() + " " + world("jello.w") + " --steps 1 -q --out /no/such/dir/o.w");
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_TRUE(contains(missing.output, "cannot write /no/such/dir/o.w")) << missing.output;
+  const Outcome unwritable =
+      run(sim() + " " + world("jello.w") + " --steps 1 -q --stats /proc/s.json");
+  EXPECT_EQ(unwritable.code, 1);
+  EXPECT_TRUE(contains(unwritable.output, "cannot write /proc/s.json")) << unwritable.output;
+}
+
 TEST(JelloSim, RefusesWorldsOverItsLimits) {
   const Outcome r = run(sim() + " " + world("jello.w") + " --max-field-resolution 16");
   EXPECT_EQ(r.code, 1);
-  EXPECT_TRUE(contains(r.output, "jello.w:7: force-field resolution must be 0 (none) or "
-                                 "between 2 and 16 (at '30')"))
+  EXPECT_TRUE(contains(r.output,
+                       "jello.w:7: force-field resolution must be 0 (none) or "
+                       "between 2 and 16 (at '30')"))
       << r.output;
 }
 
@@ -185,11 +220,11 @@ TEST(JelloCreateWorld, FlagsSetEveryField) {
   test::TempDir dir;
   const auto out = dir.path() / "w.w";
   const Outcome r = run(create() + " -o " + out.string() +
-                    " --integrator symplectic --dt 0.002 -n 3 --k-elastic 1000"
-                    " --d-elastic 0.5 --k-collision 2000 --d-collision 0.7 --mass 0.004"
-                    " --plane 0 0 1 1.5 --field vortex --field-strength 0.1"
-                    " --field-resolution 5 --pose rotated --rotate 45 --axis 0 0 1"
-                    " --velocity 1 2 3 --spin 2 --sphere 0 0 -1 0.5 --cube 6");
+                        " --integrator symplectic --dt 0.002 -n 3 --k-elastic 1000"
+                        " --d-elastic 0.5 --k-collision 2000 --d-collision 0.7 --mass 0.004"
+                        " --plane 0 0 1 1.5 --field vortex --field-strength 0.1"
+                        " --field-resolution 5 --pose rotated --rotate 45 --axis 0 0 1"
+                        " --velocity 1 2 3 --spin 2 --sphere 0 0 -1 0.5 --cube 6");
   ASSERT_EQ(r.code, 0) << r.output;
   const World w = readWorld(out);
   EXPECT_EQ(w.integrator, IntegratorKind::Symplectic);

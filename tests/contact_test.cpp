@@ -1,9 +1,9 @@
 // Penalty contact: direction, magnitude, and consistency with its energy.
+#include "contact.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
-
-#include "contact.h"
 
 namespace jello {
 namespace {

@@ -1,10 +1,11 @@
 // Trilinear interpolation of the force field.
+#include "force_field.h"
+
 #include <gtest/gtest.h>
 
 #include <limits>
 #include <random>
 
-#include "force_field.h"
 #include "scene_builder.h"
 #include "test_support.h"
 

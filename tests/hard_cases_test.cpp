@@ -19,7 +19,9 @@ struct HardCase {
   friend void PrintTo(const HardCase& c, std::ostream* os) { *os << c.name; }
 };
 
-World stiff(double k) { return buildWorld(stiffCube(k)); }
+World stiff(double k) {
+  return buildWorld(stiffCube(k));
+}
 
 World thrownIntoAWall() {
   SceneSpec spec;

@@ -12,8 +12,12 @@ namespace {
 using Oscillator = test::LinearOscillator;
 
 // Energy ratio per step on an undamped mode of frequency w, with y = h w.
-double eulerFactor(double y) { return 1 + y * y; }
-double rk4Factor(double y) { return 1 - std::pow(y, 6) / 72 + std::pow(y, 8) / 576; }
+double eulerFactor(double y) {
+  return 1 + y * y;
+}
+double rk4Factor(double y) {
+  return 1 - std::pow(y, 6) / 72 + std::pow(y, 8) / 576;
+}
 
 template <class Method>
 void expectEnergyFactorPerStep(double y, double factor, int steps) {
@@ -30,7 +34,8 @@ void expectEnergyFactorPerStep(double y, double factor, int steps) {
 
 TEST(ExplicitEuler, GrowsAnUndampedOscillatorBySqrtOnePlusH2W2PerStep) {
   // Amplitude grows by sqrt(1 + h^2 w^2), so energy by 1 + h^2 w^2, at every h.
-  for (double y : {0.01, 0.1, 0.5, 1.5}) expectEnergyFactorPerStep<ExplicitEuler>(y, eulerFactor(y), 20);
+  for (double y : {0.01, 0.1, 0.5, 1.5})
+    expectEnergyFactorPerStep<ExplicitEuler>(y, eulerFactor(y), 20);
 }
 
 TEST(RungeKutta4, ScalesAnUndampedOscillatorByItsStabilityPolynomial) {

@@ -1,10 +1,11 @@
 // Assembled Jacobians against central differences of the forces, effect by effect.
+#include "jacobian.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <random>
 
-#include "jacobian.h"
 #include "scene_builder.h"
 #include "test_support.h"
 
@@ -49,7 +50,8 @@ State twoPoints(double length) {
   s.x.setZero(6);
   s.v.setZero(6);
   State::set(s.x, 0, {0.1, -0.2, 0.05});
-  State::set(s.x, 1, Vec3{0.1, -0.2, 0.05} + Vec3{0.6, 0.3, -0.2} * (length / norm({0.6, 0.3, -0.2})));
+  State::set(s.x, 1,
+             Vec3{0.1, -0.2, 0.05} + Vec3{0.6, 0.3, -0.2} * (length / norm({0.6, 0.3, -0.2})));
   State::set(s.v, 0, {1.0, 0.0, 0.5});
   State::set(s.v, 1, {-0.5, 2.0, 0.0});
   return s;
@@ -171,9 +173,9 @@ State deformedJello(const World& w) {
   for (Eigen::Index i = 0; i < s.x.size(); ++i) s.x[i] += u(rng);
   for (Eigen::Index i = 0; i < s.v.size(); ++i) s.v[i] = 50 * u(rng);
   const int n = s.numPoints();
-  s.x[0] = -2.1;            // point 0 through the x = -2 wall
-  s.x[2 * n + 7] = 2.15;    // point 7 through the top
-  s.x[n + 300] = -1.0;      // point 300 (x near 0.7, z near 0.4) below the plane -x+y+z+2=0
+  s.x[0] = -2.1;          // point 0 through the x = -2 wall
+  s.x[2 * n + 7] = 2.15;  // point 7 through the top
+  s.x[n + 300] = -1.0;    // point 300 (x near 0.7, z near 0.4) below the plane -x+y+z+2=0
   s.x[2 * n + 300] = -1.5;
   return s;
 }

@@ -1,7 +1,8 @@
 // The model builds only the effects a scene has, and absent effects are never evaluated.
+#include "model.h"
+
 #include <gtest/gtest.h>
 
-#include "model.h"
 #include "scene_builder.h"
 #include "test_support.h"
 

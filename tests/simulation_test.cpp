@@ -1,9 +1,10 @@
 // The simulation loop: integrator choice, divergence detection, saving the state.
+#include "simulation.h"
+
 #include <gtest/gtest.h>
 
 #include <limits>
 
-#include "simulation.h"
 #include "test_support.h"
 #include "world_reader.h"
 #include "world_writer.h"
@@ -82,8 +83,8 @@ TEST(Simulation, SavedStateReadsBackBitExactly) {
 }
 
 TEST(Simulation, EveryReferenceWorldRunsATenthOfASecondWithItsOwnSettings) {
-  for (const char* name : {"jello.w", "moveLeft.w", "rotate.w", "gravity.w",
-                           "createWorld-default.w"}) {
+  for (const char* name :
+       {"jello.w", "moveLeft.w", "rotate.w", "gravity.w", "createWorld-default.w"}) {
     Simulation sim(test::loadWorld(name));
     const long steps = std::lround(0.1 / sim.dt());
     for (long i = 0; i < steps; ++i) ASSERT_TRUE(sim.step().ok) << name << " step " << i;

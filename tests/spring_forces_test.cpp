@@ -34,8 +34,8 @@ TEST(SpringForces, EqualMinusTheGradientOfTheSpringEnergy) {
     Eigen::VectorXd xp = s.x, xm = s.x;
     xp[i] += h;
     xm[i] -= h;
-    const double grad = (model.springs().energy(xp.data()) - model.springs().energy(xm.data())) /
-                        (2 * h);
+    const double grad =
+        (model.springs().energy(xp.data()) - model.springs().energy(xm.data())) / (2 * h);
     worst = std::max(worst, std::abs(f[i] + grad) / (std::abs(f[i]) + 1e-3));
   }
   EXPECT_LT(worst, 1e-6);

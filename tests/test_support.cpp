@@ -9,9 +9,13 @@
 
 namespace jello::test {
 
-std::filesystem::path worldsDir() { return JELLO_WORLDS_DIR; }
+std::filesystem::path worldsDir() {
+  return JELLO_WORLDS_DIR;
+}
 
-World loadWorld(const std::string& name) { return readWorld(worldsDir() / name); }
+World loadWorld(const std::string& name) {
+  return readWorld(worldsDir() / name);
+}
 
 std::string readFile(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -51,7 +55,9 @@ ModelSpec singleSpring(double stiffness, double damping, double rest, double mas
   return spec;
 }
 
-double LinearOscillator::omega() const { return std::sqrt(2 * stiffness / mass); }
+double LinearOscillator::omega() const {
+  return std::sqrt(2 * stiffness / mass);
+}
 
 double LinearOscillator::energy(const State& s) const {
   const Vec3 d = s.position(1) - s.position(0);

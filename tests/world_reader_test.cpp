@@ -1,4 +1,6 @@
 // The reader against the six reference worlds and every class of bad input.
+#include "world_reader.h"
+
 #include <gtest/gtest.h>
 
 #include <optional>
@@ -8,7 +10,6 @@
 
 #include "scene_builder.h"
 #include "test_support.h"
-#include "world_reader.h"
 #include "world_writer.h"
 
 namespace jello {
@@ -21,8 +22,8 @@ struct Header {
   double kElastic, kCollision;
   std::optional<Plane> plane;
   Vec3 firstFieldNode;
-  Vec3 velocity;       // of every point
-  bool skewedCorner;   // p[7][7][7] = (8/7, 8/7, 8/7)
+  Vec3 velocity;      // of every point
+  bool skewedCorner;  // p[7][7][7] = (8/7, 8/7, 8/7)
 };
 
 class ReferenceWorld : public ::testing::TestWithParam<Header> {};
@@ -70,13 +71,25 @@ INSTANTIATE_TEST_SUITE_P(
     AllSix, ReferenceWorld,
     ::testing::Values(
         Header{"jello.w", 0.0005, 200, 400, Plane{-1, 1, 1, 2}, {}, {10, -10, 20}, true},
-        Header{"createWorld-default.w", 0.0005, 200, 400, Plane{-1, 1, 1, 2}, {}, {10, -10, 20},
-               true},
+        Header{
+            "createWorld-default.w", 0.0005, 200, 400, Plane{-1, 1, 1, 2}, {}, {10, -10, 20}, true},
         Header{"moveLeft.w", 0.0005, 500, 1000, std::nullopt, {}, {-50, 0, 0}, false},
-        Header{"rotate.w", 0.001, 500, 1000, Plane{1, -1, -1, 4}, {0.019531, -0.019531, 0},
-               {0, 0, 0}, false},
+        Header{"rotate.w",
+               0.001,
+               500,
+               1000,
+               Plane{1, -1, -1, 4},
+               {0.019531, -0.019531, 0},
+               {0, 0, 0},
+               false},
         Header{"skewedCorner.w", 0.00001, 500, 1000, std::nullopt, {}, {0, 0, 0}, true},
-        Header{"gravity.w", 0.0001, 500, 1000, Plane{-1, 1, 2, 6}, {0, 0, -0.06}, {10, -10, 0},
+        Header{"gravity.w",
+               0.0001,
+               500,
+               1000,
+               Plane{-1, 1, 2, 6},
+               {0, 0, -0.06},
+               {10, -10, 0},
                false}),
     [](const auto& param_info) {
       std::string name = param_info.param.file.substr(0, param_info.param.file.find('.'));
@@ -163,8 +176,7 @@ TEST_P(BadWorld, IsRefusedNamingFileLineAndToken) {
     EXPECT_EQ(e.line(), b.expectedLine) << e.what();
     EXPECT_EQ(e.token(), b.expectedToken) << e.what();
     EXPECT_NE(std::string(e.what()).find(b.expectedMessage), std::string::npos) << e.what();
-    EXPECT_EQ(std::string(e.what()).rfind("bad.w:" + std::to_string(b.expectedLine) + ": ", 0),
-              0u)
+    EXPECT_EQ(std::string(e.what()).rfind("bad.w:" + std::to_string(b.expectedLine) + ": ", 0), 0u)
         << e.what();
   }
 }
@@ -179,8 +191,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"NanDt", 2, "nan 1", 0, "", 2, "nan", "must be finite"},
         BadInput{"NonNumericDt", 2, "fast 1", 0, "", 2, "fast", "expected a number"},
         BadInput{"ZeroStepsPerFrame", 2, "0.001 0", 0, "", 2, "0", "at least 1"},
-        BadInput{"FractionalStepsPerFrame", 2, "0.001 1.5", 0, "", 2, "1.5",
-                 "expected an integer"},
+        BadInput{"FractionalStepsPerFrame", 2, "0.001 1.5", 0, "", 2, "1.5", "expected an integer"},
         BadInput{"NegativeConstant", 3, "200 -0.25 400 0.25", 0, "", 3, "-0.25",
                  "must not be negative"},
         BadInput{"ZeroMass", 4, "0", 0, "", 4, "0", "must be positive"},
@@ -189,8 +200,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"ZeroPlaneNormal", 6, "0 0 0 2", 0, "", 6, "0", "normal (a,b,c) is zero"},
         BadInput{"FieldResolutionOne", 7, "1", 0, "", 7, "1", "force-field resolution"},
         BadInput{"NegativeFieldResolution", 7, "-3", 0, "", 7, "-3", "force-field resolution"},
-        BadInput{"HugeFieldResolution", 7, "100000", 0, "", 7, "100000",
-                 "force-field resolution"},
+        BadInput{"HugeFieldResolution", 7, "100000", 0, "", 7, "100000", "force-field resolution"},
         BadInput{"FieldLargerThanTheFile", 7, "100", 0, "", 7, "100", "too short"},
         BadInput{"NonNumericPosition", 16, "0 abc 0", 0, "", 16, "abc", "expected a number"},
         BadInput{"InfinitePosition", 20, "0 0 -inf", 0, "", 20, "-inf", "must be finite"},
@@ -198,8 +208,7 @@ INSTANTIATE_TEST_SUITE_P(
                  "truncated: 502 of 512 velocities"},
         BadInput{"TruncatedPositions", 0, "", 600, "", 439, "<end of file>",
                  "truncated: 424 of 512 positions"},
-        BadInput{"TrailingNumbers", 0, "", 0, "1 2 3\n", 1040, "1",
-                 "unknown trailing content"},
+        BadInput{"TrailingNumbers", 0, "", 0, "1 2 3\n", 1040, "1", "unknown trailing content"},
         BadInput{"UnknownKeyword", 0, "", 0, "wobble 3\n", 1040, "wobble",
                  "unknown trailing content"},
         BadInput{"CubeResolutionOne", 0, "", 0, "cube 1\n", 1040, "1", "cube resolution"},

@@ -1,4 +1,6 @@
 // The writer: exact round trips, the original creator's format, extensions, atomic replace.
+#include "world_writer.h"
+
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -9,12 +11,13 @@
 #include "scene_builder.h"
 #include "test_support.h"
 #include "world_reader.h"
-#include "world_writer.h"
 
 namespace jello {
 namespace {
 
-bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool sameBits(double a, double b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
 
 void expectSameBits(const Vec3& a, const Vec3& b) {
   EXPECT_TRUE(sameBits(a.x, b.x) && sameBits(a.y, b.y) && sameBits(a.z, b.z));

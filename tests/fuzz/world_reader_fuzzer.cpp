@@ -14,9 +14,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   limits.maxFieldResolution = 12;
   limits.maxCubeResolution = 6;
   try {
-    const jello::World w =
-        jello::parseWorld(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz",
-                          limits);
+    const jello::World w = jello::parseWorld(
+        std::string_view(reinterpret_cast<const char*>(data), size), "fuzz", limits);
     const std::size_t n = static_cast<std::size_t>(w.numPoints());
     const std::size_t r = static_cast<std::size_t>(w.field.resolution);
     if (w.positions.size() != n || w.velocities.size() != n || w.field.forces.size() != r * r * r ||
