@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "atomic_file.h"
+#include "runtime_environment.h"
 #include "scene_builder.h"
 #include "world_reader.h"
 #include "world_writer.h"
@@ -27,7 +28,8 @@ Vec3 toVec3(const std::vector<double>& v) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::signal(SIGXFSZ, SIG_IGN);  // a file-size limit fails the write (reported), not the process
+  // A file-size limit fails the write (reported), not the process.
+  jello::setSignalHandler("jello-create-world", SIGXFSZ, SIG_IGN);
   jello::SceneSpec spec;
   std::string out = "jello.w";
   std::string integrator = "rk4";

@@ -118,8 +118,8 @@ int run(const Options& opt) {
   jello::Progress progress(!opt.quiet, name + " steps");
   const auto t0 = std::chrono::steady_clock::now();
   bool diverged = false;
-  std::signal(SIGINT, onInterrupt);
-  std::signal(SIGTERM, onInterrupt);
+  jello::setSignalHandler("jello-sim", SIGINT, onInterrupt);
+  jello::setSignalHandler("jello-sim", SIGTERM, onInterrupt);
   for (long i = 0; i < total && interruptSignal == 0; ++i) {
     if (!sim.step().ok) {
       diverged = true;
@@ -129,8 +129,8 @@ int run(const Options& opt) {
     progress.update(i + 1, total);
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
+  jello::setSignalHandler("jello-sim", SIGINT, SIG_DFL);
+  jello::setSignalHandler("jello-sim", SIGTERM, SIG_DFL);
   const int interrupted = interruptSignal;
   progress.finish();
 
@@ -212,7 +212,7 @@ int main(int argc, char** argv) {
   jello::applyRuntimeEnvironment(argv);
   // A file-size limit (or a quota) must fail the write, which is reported and cleaned up, not
   // kill the process with a temporary file left behind.
-  std::signal(SIGXFSZ, SIG_IGN);
+  jello::setSignalHandler("jello-sim", SIGXFSZ, SIG_IGN);
   Options opt;
   CLI::App app{
       "Steps a jello world headless and prints a summary: steps, simulated and wall time, "

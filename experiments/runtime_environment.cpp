@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <initializer_list>
 
@@ -14,6 +16,12 @@ void applyRuntimeEnvironment(char** argv) {
   }
   if (!std::getenv("OMP_WAIT_POLICY")) changed |= ::setenv("OMP_WAIT_POLICY", "passive", 0) == 0;
   if (changed) ::execv("/proc/self/exe", argv);  // returns only on failure: run as we are
+}
+
+void setSignalHandler(const char* program, int signo, void (*handler)(int)) {
+  if (std::signal(signo, handler) == SIG_ERR) {
+    std::fprintf(stderr, "%s: warning: cannot set the handler of signal %d\n", program, signo);
+  }
 }
 
 }  // namespace jello

@@ -15,4 +15,7 @@ namespace jello {
 // (doing nothing) when all are already set or the re-execution is impossible.
 void applyRuntimeEnvironment(char** argv);
 
+// std::signal with its result checked: on failure it warns on stderr, naming `program`.
+void setSignalHandler(const char* program, int signo, void (*handler)(int));
+
 }  // namespace jello
