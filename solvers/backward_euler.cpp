@@ -32,8 +32,9 @@ StepResult BackwardEuler::factorAndSolve(double h, const Eigen::VectorXd& rhs, E
 
 double BackwardEuler::residual(const Model& model, const State& s, double h) {
   model.forces(x1_, v1_, f_);
-  g_ = model.mass() * (v1_ - s.v) - h * f_;
-  const double scale = model.mass() * (v1_ - s.v).norm() + h * f_.norm();
+  g_ = model.mass() * (v1_ - s.v);  // the momentum change, then minus the impulse
+  const double scale = g_.norm() + h * f_.norm();
+  g_ -= h * f_;
   return scale > 0.0 ? g_.norm() / scale : 0.0;
 }
 

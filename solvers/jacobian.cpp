@@ -23,16 +23,9 @@ inline void addBlock(double* block, const double B[9]) {
 
 }  // namespace
 
-JacobianAssembler::JacobianAssembler(const Model& model) : model_(model) {
+JacobianAssembler::JacobianAssembler(const Model& model)
+    : model_(model), springs_(model.springs().springs()) {
   const int n = model.numPoints();
-  for (const SpringGroup& g : model.springs().groups()) {
-    for (int s = 0; s < static_cast<int>(g.mask.size()); ++s) {
-      if (g.mask[s] == 0.0) continue;
-      springs_.push_back({g.first + s, g.first + s + g.delta, g.rest, g.kind});
-      stiffness_.push_back(g.stiffness);
-      damping_.push_back(g.damping);
-    }
-  }
   // The pattern: every point's diagonal block and both off-diagonal blocks of every spring.
   std::vector<Eigen::Triplet<double, int>> entries;
   entries.reserve(9 * (static_cast<std::size_t>(n) + 2 * springs_.size()));
@@ -88,7 +81,7 @@ void JacobianAssembler::assemble(const double* x, const double* v, const Jacobia
       alpha = 0.0;
       ++clamps;
     }
-    const double k = stiffness_[s], c = damping_[s];
+    const double k = springs_[s].stiffness, c = springs_[s].damping;
     const int* slot = &springSlots_[18 * s];
     double* Ka = &diagK_[9 * static_cast<std::size_t>(a)];
     double* Kb = &diagK_[9 * static_cast<std::size_t>(b)];

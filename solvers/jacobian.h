@@ -51,7 +51,6 @@ class JacobianAssembler {
  private:
   const Model& model_;
   std::vector<Spring> springs_;
-  std::vector<double> stiffness_, damping_;  // per spring
   SparseMatrix K_, D_;
   std::vector<int> springSlots_;       // 18 per spring: value index of blocks (a,b), (b,a)
   std::vector<int> diagSlots_;         // 9 per point: value index of its diagonal block

@@ -174,7 +174,10 @@ std::vector<Spring> SpringForces::springs() const {
   list.reserve(static_cast<std::size_t>(numSprings_));
   for (const SpringGroup& g : groups_) {
     for (int s = 0; s < static_cast<int>(g.mask.size()); ++s) {
-      if (g.mask[s] != 0.0) list.push_back({g.first + s, g.first + s + g.delta, g.rest, g.kind});
+      if (g.mask[s] != 0.0) {
+        list.push_back(
+            {g.first + s, g.first + s + g.delta, g.rest, g.kind, g.stiffness, g.damping});
+      }
     }
   }
   return list;

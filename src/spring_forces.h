@@ -26,9 +26,11 @@ struct SpringGroup {
 };
 
 struct Spring {
-  int a, b;     // point indices
-  double rest;  // m
+  int a, b;          // point indices
+  double rest;       // m
   SpringKind kind;
+  double stiffness;  // N/m
+  double damping;    // N*s/m
 };
 
 // Groups for every spring of the lattice, all with the same constants.
