@@ -26,8 +26,8 @@ struct SpringGroup {
 };
 
 struct Spring {
-  int a, b;          // point indices
-  double rest;       // m
+  int a, b;     // point indices
+  double rest;  // m
   SpringKind kind;
   double stiffness;  // N/m
   double damping;    // N*s/m
