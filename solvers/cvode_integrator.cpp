@@ -76,7 +76,7 @@ CvodeIntegrator::~CvodeIntegrator() {
 }
 
 bool CvodeIntegrator::continues(const Model& model, const State& s) const {
-  if (!cvode_ || model_ != &model || n3_ != 3 * model.numPoints() || s.t != t_) return false;
+  if (restartPending_ || !cvode_ || model_ != &model || n3_ != 3 * model.numPoints() || s.t != t_) return false;
   const double* y = N_VGetArrayPointer(y_.get());
   const std::size_t bytes = static_cast<std::size_t>(n3_) * sizeof(double);
   return std::memcmp(y, s.x.data(), bytes) == 0 && std::memcmp(y + n3_, s.v.data(), bytes) == 0;
@@ -107,6 +107,7 @@ StepResult CvodeIntegrator::start(const Model& model, const State& s) {
   std::memcpy(y + n3_, s.v.data(), static_cast<std::size_t>(n3_) * sizeof(double));
   t_ = s.t;
   assembled_ = false;
+  restartPending_ = false;
   ++restarts_;
 
   if (sameModel) {

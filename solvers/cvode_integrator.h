@@ -26,6 +26,7 @@ class CvodeIntegrator final : public Integrator {
   IntegratorKind kind() const override { return IntegratorKind::Cvode; }
   StepResult step(const Model& model, State& state, double h) override;
   std::vector<Statistic> statistics() const override;
+  void restart() override { restartPending_ = true; }
 
   // The callbacks' work (public for the C trampolines in the .cpp).
   int rightHandSide(const double* y, double* ydot);
@@ -53,6 +54,7 @@ class CvodeIntegrator final : public Integrator {
   Eigen::VectorXd rhs_, b_;
   double t_ = 0.0;  // CVODE's time, to notice a state changed from outside
   long restarts_ = 0;
+  bool restartPending_ = false;  // the model's forces changed from outside
 };
 
 }  // namespace jello

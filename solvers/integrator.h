@@ -28,6 +28,9 @@ class Integrator {
   // Advances state.x, state.v and state.t by h seconds.
   virtual StepResult step(const Model& model, State& state, double h) = 0;
   virtual std::vector<Statistic> statistics() const { return {}; }
+  // The model's forces changed from outside (a user force was set): an integrator that carries
+  // history from step to step must start afresh at the next step.
+  virtual void restart() {}
 };
 
 std::unique_ptr<Integrator> makeIntegrator(IntegratorKind kind, const SolverOptions& options = {});

@@ -56,6 +56,17 @@ void Simulation::setTimeStep(double dt) {
   dt_ = dt;
 }
 
+void Simulation::setUserForce(const Eigen::VectorXd& f) {
+  model_.setUserForce(f);
+  integrator_->restart();
+}
+
+void Simulation::clearUserForce() {
+  if (!model_.hasUserForce()) return;
+  model_.clearUserForce();
+  integrator_->restart();
+}
+
 World Simulation::currentWorld() const {
   World w = world_;
   storeState(state_, w);

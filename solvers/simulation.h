@@ -43,6 +43,10 @@ class Simulation {
   // Switches the integrator, keeping the state.
   void setIntegrator(IntegratorKind kind);
   void setTimeStep(double dt);
+  // A force from outside the world (the viewer's drag), N per point, 3n component-major;
+  // cleared with clearUserForce.
+  void setUserForce(const Eigen::VectorXd& f);
+  void clearUserForce();
 
   const World& world() const { return world_; }
   const Model& model() const { return model_; }

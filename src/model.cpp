@@ -55,6 +55,15 @@ void Model::forces(const double* x, const double* v, double* f) const {
     field_->accumulate(x, f, n_);
     ++counts_.field;
   }
+  if (userForce_) {
+    for (int i = 0; i < 3 * n_; ++i) f[i] += (*userForce_)[i];
+    ++counts_.user;
+  }
+}
+
+void Model::setUserForce(const Eigen::VectorXd& f) {
+  assert(f.size() == 3 * n_);
+  userForce_ = f;
 }
 
 void Model::acceleration(const double* x, const double* v, double* a) const {

@@ -47,6 +47,7 @@ struct EffectCounts {
   long plane = 0;
   long sphere = 0;
   long field = 0;
+  long user = 0;
 };
 
 class Model {
@@ -89,6 +90,13 @@ class Model {
   bool hasField() const { return field_.has_value(); }
   const EffectCounts& counts() const { return counts_; }
 
+  // A force a user applies from outside (the viewer's mouse drag): f (N), 3n component-major,
+  // constant in x and v, so it adds nothing to the Jacobians. Absent until set; clearing it
+  // drops the effect again. Integrators that carry history must be told (Simulation does).
+  void setUserForce(const Eigen::VectorXd& f);
+  void clearUserForce() { userForce_.reset(); }
+  bool hasUserForce() const { return userForce_.has_value(); }
+
  private:
   int n_;
   double mass_;
@@ -97,6 +105,7 @@ class Model {
   std::optional<PlaneContact> plane_;
   std::optional<SphereContact> sphere_;
   std::optional<FieldForces> field_;
+  std::optional<Eigen::VectorXd> userForce_;
   mutable EffectCounts counts_;
 };
 

@@ -35,6 +35,23 @@ TEST(Model, AnAbsentEffectIsNotEvaluated) {
   EXPECT_EQ(model.counts().wallsSkipped, 5);
 }
 
+TEST(Model, AUserForceIsAddedAsGivenAndCostsNothingOnceCleared) {
+  const World w = test::loadWorld("moveLeft.w");
+  Model model(w);
+  const State s = initialState(w);
+  Eigen::VectorXd base, pushed;
+  model.forces(s.x, s.v, base);
+  const Eigen::VectorXd user = Eigen::VectorXd::LinSpaced(s.x.size(), -1.0, 1.0);
+  model.setUserForce(user);
+  model.forces(s.x, s.v, pushed);
+  EXPECT_TRUE(pushed.isApprox(base + user, 1e-14));
+  EXPECT_EQ(model.counts().user, 1);
+  model.clearUserForce();
+  model.forces(s.x, s.v, pushed);
+  EXPECT_EQ(pushed, base);
+  EXPECT_EQ(model.counts().user, 1);
+}
+
 TEST(Model, WallsAreEvaluatedOnceAPointIsOutside) {
   World w = test::loadWorld("moveLeft.w");
   w.positions[0].x = -2.01;
