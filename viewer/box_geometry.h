@@ -1,0 +1,26 @@
+// Geometry of what the viewer draws around the cube: the inclined plane clipped to the box
+// [-2,2]^3 and the force field's arrows.
+//   plane polygon: the points where a x + b y + c z + d = 0 meets the box's 12 edges, ordered
+//   by angle around their centroid in the plane (a convex polygon of 3 to 6 corners).
+#pragma once
+
+#include <vector>
+
+#include "world.h"
+
+namespace jello::viewer {
+
+// The plane's part inside the box, corners in counter-clockwise order seen from the free side
+// (where a x + b y + c z + d > 0); empty when the plane misses the box.
+std::vector<Vec3> planeInBox(const Plane& plane);
+
+struct Arrow {
+  Vec3 tail;  // m
+  Vec3 head;  // m
+  double strength;  // |F| / max |F| over the drawn nodes, in [0, 1]
+};
+// At most `perAxis`^3 field nodes, evenly subsampled; the longest arrow is `longest` metres.
+// Nodes with zero force are left out.
+std::vector<Arrow> fieldArrows(const ForceField& field, int perAxis = 10, double longest = 0.3);
+
+}  // namespace jello::viewer

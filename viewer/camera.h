@@ -1,0 +1,68 @@
+// The viewer's z-up orbit camera and the screen <-> world maps that picking and dragging use.
+// The renderer loads exactly these matrices into GL, so what the tests compute here is what is
+// drawn.
+//   eye = radius (cos(phi) cos(theta), sin(phi) cos(theta), sin(theta)), looking at the origin,
+//   z up; perspective with a vertical field of view fovY (as gluPerspective / gluLookAt).
+// Window coordinates are pixels with the origin at the top-left corner, y down (as GLUT's).
+#pragma once
+
+#include <Eigen/Core>
+#include <numbers>
+#include <optional>
+
+#include "vec3.h"
+
+namespace jello::viewer {
+
+struct Camera {
+  double phi = std::numbers::pi / 6;    // rad, azimuth around z
+  double theta = std::numbers::pi / 6;  // rad, elevation above the xy-plane, |theta| < pi/2
+  double radius = 7.0;                  // m, distance from the origin (the whole box in view)
+  double fovY = 60.0;                   // degrees, vertical field of view
+  double zNear = 0.01, zFar = 1000.0;   // m
+
+  Vec3 eye() const;
+  // Unit vectors of the view: forward (eye to origin), right and up on the screen.
+  Vec3 forward() const;
+  Vec3 right() const;
+  Vec3 up() const;
+
+  // Right-drag: dx, dy in pixels turn the camera.
+  void rotate(double dxPixels, double dyPixels);
+  // Moves the eye closer (negative) or farther; the radius stays at least 0.5 m.
+  void zoom(double metres);
+};
+
+struct Viewport {
+  int width = 640, height = 480;  // pixels
+  double aspect() const { return double(width) / double(height); }
+};
+
+// Column-major 4x4 matrices, ready for glLoadMatrixd.
+Eigen::Matrix4d viewMatrix(const Camera& camera);
+Eigen::Matrix4d projectionMatrix(const Camera& camera, const Viewport& viewport);
+
+struct ScreenPoint {
+  double x, y;   // pixels from the top-left corner
+  double depth;  // m along the view direction from the eye
+};
+// Where a world point appears; nothing when it is behind the eye.
+std::optional<ScreenPoint> project(const Camera& camera, const Viewport& viewport, const Vec3& p);
+
+struct Ray {
+  Vec3 origin;     // the eye
+  Vec3 direction;  // unit
+};
+// The ray from the eye through pixel (x, y).
+Ray pixelRay(const Camera& camera, const Viewport& viewport, double x, double y);
+
+// Where the ray through pixel (x, y) meets the plane through `anchor` facing the camera: the
+// point a picked point is pulled towards.
+Vec3 dragTarget(const Camera& camera, const Viewport& viewport, double x, double y,
+                const Vec3& anchor);
+
+// A drag of (dx, dy) pixels as a world direction in the screen's plane (not normalized: one
+// unit per pixel), y down on the screen mapping to -up.
+Vec3 screenDragToWorld(const Camera& camera, double dxPixels, double dyPixels);
+
+}  // namespace jello::viewer

@@ -1,0 +1,98 @@
+// jello: the interactive viewer.
+//   jello [WORLD] [--integrator NAME] [--dt S] [--record DIR --frames N] [--size WxH]
+// Exit codes: 0 done, 1 runtime failure (no display, a frame not written), 2 bad arguments or
+// world file, 3 the simulation diverged while recording or benchmarking.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <regex>
+
+#include "runtime_environment.h"
+#include "viewer_app.h"
+#include "viewer_state.h"
+#include "world_reader.h"
+
+namespace {
+
+constexpr int kExitUsage = 2;
+
+// worlds/jello.w from the current directory, else from the source tree this was built from.
+std::filesystem::path defaultWorld() {
+  const std::filesystem::path local = "worlds/jello.w";
+  if (std::filesystem::exists(local)) return local;
+  return std::filesystem::path(JELLO_WORLDS_DIR) / "jello.w";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  jello::applyRuntimeEnvironment(argv);
+  jello::viewer::ViewerOptions opt;
+  std::string world = defaultWorld().string(), integrator, size = "640x480";
+  CLI::App app{"jello: the interactive jello cube. Keys and mouse:\n" +
+               jello::viewer::keyTable()};
+  app.add_option("world", world, "World file")->capture_default_str();
+  app.add_option("--integrator", integrator,
+                 "Integrator, overriding the file's: " + jello::integratorNameList());
+  app.add_option("--dt", opt.source.dt, "Time step (s), overriding the file's")
+      ->check(CLI::PositiveNumber);
+  auto* record = app.add_option("--record", opt.recordDir,
+                                "Write frames 000.jpg, 001.jpg, ... into this directory and exit");
+  app.add_option("--frames", opt.frames, "Number of frames to record (1-300: 15 per second)")
+      ->check(CLI::Range(1, jello::viewer::kMaxRecordedFrames))
+      ->needs(record);
+  record->needs("--frames");
+  app.add_option("--size", size, "Window size WxH in pixels")->capture_default_str();
+  app.add_flag("--realtime", opt.realTime,
+               "Advance by wall-clock time instead of the world's n*dt per frame");
+  app.add_flag("--wireframe", opt.wireframe, "Start in wireframe mode");
+  app.add_flag("!--no-hud", opt.hud, "Hide the heads-up line");
+  app.add_option("--benchmark", opt.benchmarkFrames,
+                 "Draw this many frames as fast as possible, print frames/s and exit")
+      ->check(CLI::PositiveNumber)
+      ->excludes(record);
+  app.add_option("--max-field-resolution", opt.source.limits.maxFieldResolution,
+                 "Largest force-field resolution a world may ask for")
+      ->check(CLI::Range(2, 1024))
+      ->capture_default_str();
+  app.add_option("--max-cube-resolution", opt.source.limits.maxCubeResolution,
+                 "Largest cube resolution a world may ask for")
+      ->check(CLI::Range(2, 256))
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : kExitUsage;
+  }
+  const auto usageError = [&](const std::string& message) {
+    std::cerr << "jello: error: " << message << "\n\n" << app.help();
+    return kExitUsage;
+  };
+  std::smatch m;
+  static const std::regex sizePattern(R"((\d{2,5})x(\d{2,5}))");
+  if (!std::regex_match(size, m, sizePattern)) {
+    return usageError("--size wants WxH in pixels, e.g. 640x480, not '" + size + "'");
+  }
+  opt.size = {std::stoi(m[1]), std::stoi(m[2])};
+  if (opt.size.width < 16 || opt.size.height < 16 || opt.size.width > 8192 ||
+      opt.size.height > 8192) {
+    return usageError("--size must be between 16x16 and 8192x8192");
+  }
+  if (!integrator.empty()) {
+    opt.source.integrator = jello::parseIntegratorName(integrator);
+    if (!opt.source.integrator) {
+      return usageError("unknown integrator '" + integrator +
+                        "' (known: " + jello::integratorNameList() + ")");
+    }
+  }
+  opt.source.world = world;
+  jello::World loaded;
+  try {
+    loaded = jello::readWorld(opt.source.world, opt.source.limits);
+  } catch (const std::exception& e) {
+    return usageError(e.what());
+  }
+  return jello::viewer::runViewer(opt, std::move(loaded));
+}

@@ -1,0 +1,241 @@
+#include "renderer.h"
+
+// glWindowPos (GL 1.4) is declared only with the extension prototypes.
+#define GL_GLEXT_PROTOTYPES
+#include <GL/freeglut.h>
+#include <GL/gl.h>
+
+#include "contact.h"
+
+namespace jello::viewer {
+namespace {
+
+void vertex(const Vec3& p) {
+  glVertex3d(p.x, p.y, p.z);
+}
+
+void drawBox() {
+  const double h = kBoxHalfSize;
+  glColor3f(0.75f, 0.75f, 0.8f);
+  glBegin(GL_LINES);
+  for (int axis = 0; axis < 3; ++axis) {
+    for (double u : {-h, h}) {
+      for (double w : {-h, h}) {
+        double a[3], b[3];
+        a[axis] = -h;
+        b[axis] = h;
+        a[(axis + 1) % 3] = b[(axis + 1) % 3] = u;
+        a[(axis + 2) % 3] = b[(axis + 2) % 3] = w;
+        glVertex3dv(a);
+        glVertex3dv(b);
+      }
+    }
+  }
+  // A grid on the floor, for depth.
+  glColor3f(0.3f, 0.3f, 0.36f);
+  for (int i = 1; i < 8; ++i) {
+    const double c = -h + i * 0.5;
+    glVertex3d(c, -h, -h);
+    glVertex3d(c, h, -h);
+    glVertex3d(-h, c, -h);
+    glVertex3d(h, c, -h);
+  }
+  glEnd();
+}
+
+void drawShadedCube(const Scene& scene) {
+  const std::vector<Vec3> normals = vertexNormals(*scene.mesh, *scene.state);
+  glEnable(GL_LIGHTING);
+  const GLfloat diffuse[] = {0.85f, 0.18f, 0.28f, 1.0f}, specular[] = {0.5f, 0.5f, 0.5f, 1.0f};
+  glMaterialfv(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE, diffuse);
+  glMaterialfv(GL_FRONT_AND_BACK, GL_SPECULAR, specular);
+  glMaterialf(GL_FRONT_AND_BACK, GL_SHININESS, 40.0f);
+  glBegin(GL_TRIANGLES);
+  for (const auto& t : scene.mesh->triangles) {
+    for (int p : t) {
+      const Vec3& n = normals[p];
+      glNormal3d(n.x, n.y, n.z);
+      vertex(scene.state->position(p));
+    }
+  }
+  glEnd();
+  glDisable(GL_LIGHTING);
+}
+
+void drawWireframeCube(const ViewerState& view, const Scene& scene) {
+  glPointSize(4.0f);
+  glColor3f(0.95f, 0.95f, 0.95f);
+  glBegin(GL_POINTS);
+  for (int p : scene.mesh->points) vertex(scene.state->position(p));
+  glEnd();
+  glBegin(GL_LINES);
+  for (const Spring& s : *scene.springs) {
+    switch (s.kind) {
+      case SpringKind::Structural:
+        if (!view.structural) continue;
+        glColor3f(0.35f, 0.75f, 1.0f);
+        break;
+      case SpringKind::FaceShear:
+      case SpringKind::BodyShear:
+        if (!view.shear) continue;
+        glColor3f(0.4f, 0.9f, 0.4f);
+        break;
+      case SpringKind::Bend:
+        if (!view.bend) continue;
+        glColor3f(1.0f, 0.85f, 0.3f);
+        break;
+    }
+    vertex(scene.state->position(s.a));
+    vertex(scene.state->position(s.b));
+  }
+  glEnd();
+}
+
+// The six faces of the box as clip planes: a x + b y + c z + d >= 0 is kept.
+void clipToBox(bool on) {
+  const double h = kBoxHalfSize;
+  const GLdouble planes[6][4] = {{1, 0, 0, h}, {-1, 0, 0, h}, {0, 1, 0, h},
+                                 {0, -1, 0, h}, {0, 0, 1, h}, {0, 0, -1, h}};
+  for (int i = 0; i < 6; ++i) {
+    if (on) {
+      glClipPlane(GL_CLIP_PLANE0 + i, planes[i]);
+      glEnable(GL_CLIP_PLANE0 + i);
+    } else {
+      glDisable(GL_CLIP_PLANE0 + i);
+    }
+  }
+}
+
+void drawSphere(const Sphere& sphere) {
+  glEnable(GL_LIGHTING);
+  const GLfloat diffuse[] = {0.55f, 0.6f, 0.68f, 1.0f};
+  glMaterialfv(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE, diffuse);
+  clipToBox(true);
+  glPushMatrix();
+  glTranslated(sphere.center.x, sphere.center.y, sphere.center.z);
+  glutSolidSphere(sphere.radius, 48, 32);
+  glPopMatrix();
+  clipToBox(false);
+  glDisable(GL_LIGHTING);
+}
+
+void drawPlane(const Plane& plane) {
+  const std::vector<Vec3> polygon = planeInBox(plane);
+  if (polygon.empty()) return;
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  glDepthMask(GL_FALSE);
+  glColor4f(0.3f, 0.6f, 0.9f, 0.35f);
+  glBegin(GL_POLYGON);
+  for (const Vec3& p : polygon) vertex(p);
+  glEnd();
+  glDepthMask(GL_TRUE);
+  glDisable(GL_BLEND);
+  glColor3f(0.45f, 0.75f, 1.0f);
+  glBegin(GL_LINE_LOOP);
+  for (const Vec3& p : polygon) vertex(p);
+  glEnd();
+}
+
+void drawArrows(const std::vector<Arrow>& arrows) {
+  glBegin(GL_LINES);
+  for (const Arrow& a : arrows) {
+    const float s = static_cast<float>(a.strength);
+    glColor3f(0.3f + 0.7f * s, 0.9f - 0.5f * s, 0.3f);
+    vertex(a.tail);
+    vertex(a.head);
+  }
+  glEnd();
+  glPointSize(3.0f);
+  glBegin(GL_POINTS);
+  for (const Arrow& a : arrows) {
+    glColor3f(1.0f, 1.0f, 1.0f);
+    vertex(a.head);
+  }
+  glEnd();
+}
+
+void drawText(int x, int y, const std::string& text) {
+  glWindowPos2i(x, y);
+  glutBitmapString(GLUT_BITMAP_8_BY_13, reinterpret_cast<const unsigned char*>(text.c_str()));
+}
+
+void drawOverlay(const Viewport& viewport, const ViewerState& view, const Overlay& overlay) {
+  glDisable(GL_DEPTH_TEST);
+  if (view.showHud && !overlay.hud.empty()) {
+    glColor3f(0.92f, 0.92f, 0.92f);
+    drawText(8, viewport.height - 18, overlay.hud);
+  }
+  if (!overlay.message.empty()) {
+    if (overlay.alarm) {
+      glColor3f(1.0f, 0.35f, 0.3f);
+    } else {
+      glColor3f(0.6f, 1.0f, 0.6f);
+    }
+    drawText(8, 10, overlay.message);
+  }
+  glEnable(GL_DEPTH_TEST);
+}
+
+}  // namespace
+
+void initRenderer() {
+  glEnable(GL_DEPTH_TEST);
+  glEnable(GL_NORMALIZE);
+  glShadeModel(GL_SMOOTH);
+  glEnable(GL_LINE_SMOOTH);
+  glLightModeli(GL_LIGHT_MODEL_TWO_SIDE, GL_TRUE);
+  const GLfloat ambient[] = {0.18f, 0.18f, 0.2f, 1.0f};
+  glLightModelfv(GL_LIGHT_MODEL_AMBIENT, ambient);
+  const GLfloat key[] = {0.85f, 0.85f, 0.82f, 1.0f}, fill[] = {0.35f, 0.35f, 0.42f, 1.0f};
+  glLightfv(GL_LIGHT0, GL_DIFFUSE, key);
+  glLightfv(GL_LIGHT0, GL_SPECULAR, key);
+  glLightfv(GL_LIGHT1, GL_DIFFUSE, fill);
+  glEnable(GL_LIGHT0);
+  glEnable(GL_LIGHT1);
+}
+
+void drawFrame(const ViewerState& view, const Viewport& viewport, const Scene& scene,
+               const Overlay& overlay) {
+  glViewport(0, 0, viewport.width, viewport.height);
+  glClearColor(kBackground[0], kBackground[1], kBackground[2], 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glMatrixMode(GL_PROJECTION);
+  const Eigen::Matrix4d projection = projectionMatrix(view.camera, viewport);
+  glLoadMatrixd(projection.data());
+  glMatrixMode(GL_MODELVIEW);
+  const Eigen::Matrix4d model = viewMatrix(view.camera);
+  glLoadMatrixd(model.data());
+  // Directional lights fixed in the world: a key light from above the camera's side, a fill.
+  const GLfloat keyDirection[] = {0.4f, 0.5f, 1.0f, 0.0f}, fillDirection[] = {-0.6f, -0.3f, 0.2f, 0.0f};
+  glLightfv(GL_LIGHT0, GL_POSITION, keyDirection);
+  glLightfv(GL_LIGHT1, GL_POSITION, fillDirection);
+
+  drawBox();
+  if (view.mode == DisplayMode::Shaded) {
+    drawShadedCube(scene);
+  } else {
+    drawWireframeCube(view, scene);
+  }
+  if (scene.world->sphere) drawSphere(*scene.world->sphere);
+  if (view.showField && scene.arrows) drawArrows(*scene.arrows);
+  if (scene.pull) {
+    glColor3f(1.0f, 1.0f, 0.2f);
+    glBegin(GL_LINES);
+    vertex(scene.pull->first);
+    vertex(scene.pull->second);
+    glEnd();
+  }
+  if (scene.world->plane) drawPlane(*scene.world->plane);  // blended: last
+  drawOverlay(viewport, view, overlay);
+}
+
+std::vector<std::uint8_t> readBackBuffer(const Viewport& viewport) {
+  std::vector<std::uint8_t> pixels(static_cast<std::size_t>(viewport.width) * viewport.height * 3);
+  glReadBuffer(GL_BACK);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, viewport.width, viewport.height, GL_RGB, GL_UNSIGNED_BYTE, pixels.data());
+  return pixels;
+}
+
+}  // namespace jello::viewer

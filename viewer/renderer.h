@@ -1,0 +1,45 @@
+// Draws one frame with OpenGL's fixed-function pipeline (Mesa's llvmpipe runs it headless):
+// the box, the cube shaded with per-vertex normals or as a wireframe of its surface springs,
+// the inclined plane and the sphere clipped to the box, field arrows, and the heads-up text.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "box_geometry.h"
+#include "camera.h"
+#include "state.h"
+#include "surface.h"
+#include "viewer_state.h"
+#include "world.h"
+
+namespace jello::viewer {
+
+// The background colour: tests look for it.
+inline constexpr float kBackground[3] = {0.10f, 0.11f, 0.14f};
+
+struct Scene {
+  const World* world = nullptr;             // plane, sphere
+  const State* state = nullptr;             // positions to draw (always a sane state)
+  const SurfaceMesh* mesh = nullptr;
+  const std::vector<Spring>* springs = nullptr;  // surface springs
+  const std::vector<Arrow>* arrows = nullptr;    // field arrows
+  std::optional<std::pair<Vec3, Vec3>> pull;     // picked point and its target, while pulling
+};
+
+struct Overlay {
+  std::string hud;      // the heads-up line
+  std::string message;  // an error or notice, drawn in its own colour
+  bool alarm = false;   // the message is an error (red) rather than a notice
+};
+
+// Once, after the window exists: depth test, lights, materials.
+void initRenderer();
+void drawFrame(const ViewerState& view, const Viewport& viewport, const Scene& scene,
+               const Overlay& overlay);
+
+// The back buffer's pixels, bottom row first (GL order), RGB.
+std::vector<std::uint8_t> readBackBuffer(const Viewport& viewport);
+
+}  // namespace jello::viewer

@@ -1,0 +1,85 @@
+#include "viewer_state.h"
+
+#include <array>
+#include <cmath>
+#include <sstream>
+
+#include "interaction.h"
+
+namespace jello::viewer {
+
+KeyResult handleKey(ViewerState& s, unsigned char key) {
+  const auto integrators = allIntegrators();
+  if (key >= '1' && key < '1' + integrators.size()) {
+    return {Command::SwitchIntegrator, integrators[key - '1']};
+  }
+  switch (key) {
+    case 27: return {Command::Quit, {}};
+    case ' ': return {Command::Screenshot, {}};
+    case 'r': return {Command::Reload, {}};
+    case 'e': s.camera = Camera{}; break;
+    case 'z': s.camera.zoom(-0.2); break;
+    case 'x': s.camera.zoom(0.2); break;
+    case 'v':
+      s.mode = s.mode == DisplayMode::Shaded ? DisplayMode::Wireframe : DisplayMode::Shaded;
+      break;
+    case 's': s.structural = !s.structural; break;
+    case 'h': s.shear = !s.shear; break;
+    case 'b': s.bend = !s.bend; break;
+    case 'p': s.paused = !s.paused; break;
+    case 'f': s.showField = !s.showField; break;
+    case 'i': s.showHud = !s.showHud; break;
+    case 'g': s.pullMode = !s.pullMode; break;
+    case '[': s.pullRadius = std::max(0, s.pullRadius - 1); break;
+    case ']': s.pullRadius = std::min(int(pullRadii().size()) - 1, s.pullRadius + 1); break;
+    case '+':
+    case '=':
+      s.dtScale *= 2.0;
+      return {Command::TimeStep, {}};
+    case '-':
+      s.dtScale *= 0.5;
+      return {Command::TimeStep, {}};
+    case '.': return {Command::StepOnce, {}};
+    default: break;
+  }
+  return {};
+}
+
+std::span<const KeyBinding> keyBindings() {
+  static constexpr std::array<KeyBinding, 18> table{{
+      {"right-drag", "rotate the camera"},
+      {"left-drag", "push the whole cube in the dragged direction"},
+      {"Shift+left-drag", "pull the surface point under the cursor (also left-drag in pull mode)"},
+      {"g", "pull mode on/off"},
+      {"[ ]", "pull radius smaller/larger: one point ... the whole cube"},
+      {"z x", "zoom in/out"},
+      {"e", "reset the camera"},
+      {"v", "wireframe/shaded"},
+      {"s h b", "wireframe: structural, shear, bend springs on/off"},
+      {"p", "pause/resume"},
+      {".", "advance one frame while paused"},
+      {"1-5", "integrator: 1 euler, 2 symplectic, 3 rk4, 4 implicit, 5 cvode (same state)"},
+      {"+ -", "time step x2, /2 (simulated time per frame stays n*dt of the world)"},
+      {"r", "reload the world file (a bad file keeps the running scene)"},
+      {"f", "force-field arrows on/off"},
+      {"i", "heads-up line on/off"},
+      {"space", "save a screenshot (jello-NNN.jpg in the current directory)"},
+      {"ESC", "quit"},
+  }};
+  return table;
+}
+
+std::string keyTable() {
+  std::ostringstream os;
+  for (const KeyBinding& k : keyBindings()) {
+    os << "  " << k.keys << std::string(18 - std::string(k.keys).size(), ' ') << k.action << '\n';
+  }
+  return os.str();
+}
+
+int stepsPerFrame(double frameTime, double dt) {
+  const double steps = std::round(frameTime / dt);
+  return steps < 1.0 ? 1 : steps > 1e6 ? 1000000 : int(steps);
+}
+
+}  // namespace jello::viewer

@@ -1,0 +1,60 @@
+// Everything the viewer's keys change, and the keys themselves, free of GL: the GLUT callbacks
+// only forward keys here and act on the returned command, so key handling is unit-tested.
+#pragma once
+
+#include <optional>
+#include <span>
+#include <string>
+
+#include "camera.h"
+#include "integrator_name.h"
+
+namespace jello::viewer {
+
+enum class DisplayMode { Shaded, Wireframe };
+
+struct ViewerState {
+  Camera camera;
+  DisplayMode mode = DisplayMode::Shaded;
+  bool structural = true;  // wireframe: springs of each kind drawn
+  bool shear = false;
+  bool bend = false;
+  bool paused = false;
+  bool showField = false;  // force-field arrows
+  bool showHud = true;     // the heads-up line
+  bool pullMode = false;   // left-drag pulls the picked point (also with Shift held)
+  int pullRadius = 0;      // index into pullRadii()
+  double dtScale = 1.0;    // the time step is the starting one times this
+};
+
+enum class Command {
+  None,              // the state changed (or nothing did); redraw
+  Quit,              // ESC
+  Screenshot,        // space
+  Reload,            // r: read the world file again
+  SwitchIntegrator,  // 1-5: see KeyResult::integrator
+  TimeStep,          // + / -: dtScale changed
+  StepOnce,          // . : one frame while paused
+};
+
+struct KeyResult {
+  Command command = Command::None;
+  std::optional<IntegratorKind> integrator;
+};
+
+// Applies key `key` to the state; unknown keys do nothing.
+KeyResult handleKey(ViewerState& state, unsigned char key);
+
+struct KeyBinding {
+  const char* keys;
+  const char* action;
+};
+// The key table, one source for --help, the README and the on-screen help.
+std::span<const KeyBinding> keyBindings();
+std::string keyTable();  // "  keys  action" lines
+
+// Simulated seconds to advance per displayed frame, split into whole steps of at most dt:
+// the frame time is the world's n*dt0 (fixed when +/- change dt), at least one step.
+int stepsPerFrame(double frameTime, double dt);
+
+}  // namespace jello::viewer
