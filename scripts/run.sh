@@ -1,8 +1,15 @@
 #!/usr/bin/env bash
-# The main job: installs what is missing, builds (Release) and runs jello-sim on worlds/jello.w.
-# Arguments go to jello-sim, e.g. `scripts/run.sh --integrator euler --time 5`.
+# The main job: installs what is missing, builds (Release) and opens the viewer on
+# worlds/jello.w. Without a display it records the animation instead: 300 frames (20 s of
+# animation at 15 frames/s) into frames/000.jpg ... under Xvfb.
+# Arguments go to the viewer, e.g. `scripts/run.sh --integrator implicit --dt 0.01`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/build.sh release
-exec build/release/experiments/jello-sim worlds/jello.w "$@"
+viewer=build/release/viewer/jello
+if [ -n "${DISPLAY:-}" ]; then
+  exec "$viewer" worlds/jello.w "$@"
+fi
+echo "run: no display: recording worlds/jello.w to frames/ under Xvfb"
+exec xvfb-run -a -s "-screen 0 1024x768x24" "$viewer" worlds/jello.w --record frames --frames 300 "$@"

@@ -30,8 +30,10 @@ int main(int argc, char** argv) {
   jello::applyRuntimeEnvironment(argv);
   jello::viewer::ViewerOptions opt;
   std::string world = defaultWorld().string(), integrator, size = "640x480";
-  CLI::App app{"jello: the interactive jello cube. Keys and mouse:\n" +
-               jello::viewer::keyTable()};
+  CLI::App app{"jello: the interactive jello cube (OpenGL/GLUT viewer)"};
+  app.footer("\nKeys and mouse:\n" + jello::viewer::keyTable() +
+             "\nExit codes: 0 done, 1 no display or a frame not written, 2 bad arguments or world, "
+             "3 diverged while recording.");
   app.add_option("world", world, "World file")->capture_default_str();
   app.add_option("--integrator", integrator,
                  "Integrator, overriding the file's: " + jello::integratorNameList());

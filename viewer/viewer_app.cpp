@@ -165,11 +165,12 @@ void Viewer::display() {
                     options_.recordDir.c_str(), sim.state().t);
       } else {
         const double elapsed = seconds(now - started_);
-        std::printf("%d frames in %.3f s: %.1f frames/s (%s, %dx%d, %s, t = %.4g s)\n",
+        const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+        std::printf("%d frames in %.3f s: %.1f frames/s (%s, %dx%d, %s, t = %.4g s; %s)\n",
                     framesDrawn_, elapsed, framesDrawn_ / elapsed,
                     view_.mode == DisplayMode::Shaded ? "shaded" : "wireframe", viewport_.width,
                     viewport_.height, std::string(integratorName(sim.integrator())).c_str(),
-                    sim.state().t);
+                    sim.state().t, renderer ? renderer : "unknown renderer");
       }
       return leave(sim.divergence() ? 3 : 0);
     }
@@ -288,7 +289,8 @@ int runViewer(const ViewerOptions& options, World world) {
   glutSetOption(GLUT_ACTION_ON_WINDOW_CLOSE, GLUT_ACTION_GLUTMAINLOOP_RETURNS);
   glutInitDisplayMode(GLUT_DOUBLE | GLUT_RGB | GLUT_DEPTH);
   glutInitWindowSize(options.size.width, options.size.height);
-  if (glutCreateWindow("jello") <= 0) {
+  const int window = glutCreateWindow("jello");
+  if (window <= 0) {
     std::cerr << "jello: cannot create a window\n";
     return 1;
   }
@@ -303,6 +305,10 @@ int runViewer(const ViewerOptions& options, World world) {
   glutIdleFunc([] { glutPostRedisplay(); });
   glutMainLoop();
   active = nullptr;
+  // The window is still open when the loop returns after glutLeaveMainLoop: close it and let
+  // freeglut release its state, so the GL driver's memory is freed before exit.
+  if (glutGetWindow() == window) glutDestroyWindow(window);
+  glutExit();
   return viewer.exitCode();
 }
 

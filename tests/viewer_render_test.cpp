@@ -1,0 +1,259 @@
+// The viewer as a user runs it, headless under Xvfb (xvfb-run -a picks a free display): frames
+// show the cube where the camera says, the two modes differ, a recording is a sequence of
+// valid, changing JPEGs, and bad input gets a message and an exit code instead of a crash.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "camera.h"
+#include "image_writer.h"
+#include "renderer.h"
+#include "state.h"
+#include "test_support.h"
+
+namespace jello::viewer {
+namespace {
+
+struct Outcome {
+  int code;
+  std::string output;
+};
+
+Outcome run(const std::string& command) {
+  std::string output;
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return {-1, "popen failed"};
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) output.append(buf, n);
+  const int status = ::pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+std::string jello() {
+  return JELLO_VIEWER;
+}
+// Under the sanitizer build, leak checking is off for the rendering process only: Mesa's
+// llvmpipe keeps its back buffer (1.2 MB) and driver state past exit, allocated from a driver
+// it has unloaded by then, so LeakSanitizer cannot name it in a suppression. The viewer's own
+// logic is leak-checked in-process by viewer_test.
+std::string headless(const std::string& arguments) {
+  return "ASAN_OPTIONS=detect_leaks=0 xvfb-run -a -s '-screen 0 1024x768x24' " + jello() + " " +
+         arguments;
+}
+std::string world(const char* name) {
+  return (test::worldsDir() / name).string();
+}
+
+struct Rgb {
+  int r, g, b;
+};
+Rgb pixel(const Image& image, int x, int y) {
+  const std::size_t i = (static_cast<std::size_t>(y) * image.width + x) * 3;
+  return {image.rgb[i], image.rgb[i + 1], image.rgb[i + 2]};
+}
+bool isBackground(const Rgb& c) {
+  // JPEG blurs colours by a few levels.
+  return std::abs(c.r - int(kBackground[0] * 255)) <= 8 &&
+         std::abs(c.g - int(kBackground[1] * 255)) <= 8 &&
+         std::abs(c.b - int(kBackground[2] * 255)) <= 8;
+}
+double meanDifference(const Image& a, const Image& b) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < a.rgb.size(); ++i) sum += std::abs(int(a.rgb[i]) - int(b.rgb[i]));
+  return sum / double(a.rgb.size());
+}
+
+// One frame of jello.w at t = 0 in each mode, shared by the checks below.
+class Frames : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new test::TempDir;
+    for (const char* mode : {"shaded", "wireframe"}) {
+      const std::string out = (dir_->path() / mode).string();
+      const Outcome r = run(headless(world("jello.w") + " --no-hud --frames 1 --record " + out +
+                                     (std::string(mode) == "wireframe" ? " --wireframe" : "")));
+      ASSERT_EQ(r.code, 0) << r.output;
+    }
+  }
+  static void TearDownTestSuite() { delete dir_; }
+  static Image frame(const char* mode) { return readImage(dir_->path() / mode / "000.jpg"); }
+
+  static test::TempDir* dir_;
+};
+test::TempDir* Frames::dir_ = nullptr;
+
+TEST_F(Frames, TheShadedCubeIsWhereTheCameraProjectsIt) {
+  const Image image = frame("shaded");
+  ASSERT_EQ(image.width, 640);
+  ASSERT_EQ(image.height, 480);
+  const State s = initialState(test::loadWorld("jello.w"));
+  const Viewport viewport{640, 480};
+  const Camera camera;
+  // The centroid of the cube and the middle of each face seen by the camera: jello red.
+  Vec3 centroid;
+  for (int p = 0; p < s.numPoints(); ++p) centroid += s.position(p) * (1.0 / s.numPoints());
+  const auto c = project(camera, viewport, centroid);
+  ASSERT_TRUE(c.has_value());
+  const Rgb centre = pixel(image, int(c->x), int(c->y));
+  EXPECT_GT(centre.r, 80) << centre.r << " " << centre.g << " " << centre.b;
+  EXPECT_GT(centre.r, 2 * centre.g);
+  EXPECT_GT(centre.r, 2 * centre.b);
+  // Ten pixels beyond the cube's projected extent, left and right: not the cube.
+  double left = 1e9, right = -1e9;
+  for (int p = 0; p < s.numPoints(); ++p) {
+    const auto q = project(camera, viewport, s.position(p));
+    left = std::min(left, q->x);
+    right = std::max(right, q->x);
+  }
+  for (int x : {int(left) - 10, int(right) + 10}) {
+    const Rgb outside = pixel(image, x, int(c->y));
+    EXPECT_FALSE(outside.r > 2 * outside.g && outside.r > 80) << "cube colour at x = " << x;
+  }
+}
+
+TEST_F(Frames, TheBackgroundIsTheBackground) {
+  const Image image = frame("shaded");
+  // Window corners outside the box's projection are bare background.
+  const Viewport viewport{640, 480};
+  double left = 1e9, right = -1e9, top = 1e9, bottom = -1e9;
+  for (double x : {-2.0, 2.0}) {
+    for (double y : {-2.0, 2.0}) {
+      for (double z : {-2.0, 2.0}) {
+        const auto q = project(Camera{}, viewport, {x, y, z});
+        left = std::min(left, q->x), right = std::max(right, q->x);
+        top = std::min(top, q->y), bottom = std::max(bottom, q->y);
+      }
+    }
+  }
+  int checked = 0;
+  for (int x : {3, 636}) {
+    for (int y : {3, 476}) {
+      if (x > left - 5 && x < right + 5 && y > top - 5 && y < bottom + 5) continue;
+      ++checked;
+      const Rgb c = pixel(image, x, y);
+      EXPECT_TRUE(isBackground(c)) << x << "," << y << ": " << c.r << " " << c.g << " " << c.b;
+    }
+  }
+  EXPECT_GT(checked, 0);
+  long background = 0;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) background += isBackground(pixel(image, x, y));
+  }
+  EXPECT_GT(double(background) / (640.0 * 480.0), 0.5);
+}
+
+TEST_F(Frames, WireframeAndShadedModesDiffer) {
+  const Image shaded = frame("shaded"), wire = frame("wireframe");
+  EXPECT_GT(meanDifference(shaded, wire), 2.0);
+  // The wireframe's cube is lines: the centroid's neighbourhood is partly background, partly
+  // not, and nowhere jello red.
+  const State s = initialState(test::loadWorld("jello.w"));
+  Vec3 centroid;
+  for (int p = 0; p < s.numPoints(); ++p) centroid += s.position(p) * (1.0 / s.numPoints());
+  const auto c = project(Camera{}, Viewport{640, 480}, centroid);
+  int lines = 0, total = 0;
+  for (int dy = -12; dy <= 12; ++dy) {
+    for (int dx = -12; dx <= 12; ++dx) {
+      const Rgb p = pixel(wire, int(c->x) + dx, int(c->y) + dy);
+      lines += !isBackground(p);
+      ++total;
+      EXPECT_FALSE(p.r > 2 * p.g && p.r > 120);
+    }
+  }
+  EXPECT_GT(lines, total / 10);
+  EXPECT_LT(lines, total);
+}
+
+TEST(Recording, ThirtyFramesAreThirtyValidChangingJpegs) {
+  test::TempDir dir;
+  const auto out = dir.path() / "frames";
+  const Outcome r = run(headless(world("jello.w") + " --no-hud --frames 30 --record " +
+                                 out.string()));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("wrote 30 frames"), std::string::npos) << r.output;
+  Image previous;
+  for (int i = 0; i < 30; ++i) {
+    char name[16];
+    std::snprintf(name, sizeof name, "%03d.jpg", i);
+    const Image image = readImage(out / name);
+    EXPECT_EQ(image.width, 640);
+    EXPECT_EQ(image.height, 480);
+    if (i > 0) {
+      EXPECT_GT(meanDifference(previous, image), 0.01) << "frame " << i;
+    }
+    previous = image;
+  }
+  EXPECT_FALSE(std::filesystem::exists(out / "030.jpg"));
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(out)) ++files;
+  EXPECT_EQ(files, 30u);  // no temporary left behind
+}
+
+TEST(Recording, EveryIntegratorAndTheSphereSceneRecord) {
+  test::TempDir dir;
+  for (const char* integrator : {"euler", "symplectic", "rk4", "implicit", "cvode"}) {
+    const Outcome r = run(headless(world("sphere-drop.w") + " --frames 3 --integrator " +
+                                   integrator + " --record " + (dir.path() / integrator).string()));
+    EXPECT_EQ(r.code, 0) << integrator << "\n" << r.output;
+    EXPECT_TRUE(std::filesystem::exists(dir.path() / integrator / "002.jpg")) << integrator;
+  }
+}
+
+TEST(Recording, ADivergingSimulationStopsWithExitCodeThree) {
+  test::TempDir dir;
+  const Outcome r = run(headless(world("jello.w") + " --integrator euler --dt 0.01 --frames 100 "
+                                 "--record " + dir.path().string()));
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_NE(r.output.find("diverged"), std::string::npos) << r.output;
+}
+
+TEST(ViewerCommandLine, AMissingWorldGetsTheUsageMessage) {
+  const Outcome r = run(jello() + " /nonexistent/world.w");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("/nonexistent/world.w"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("Usage"), std::string::npos) << r.output;
+}
+
+TEST(ViewerCommandLine, ABadWorldNamesFileLineAndToken) {
+  test::TempDir dir;
+  const auto bad = dir.path() / "bad.w";
+  std::string text = test::readFile(test::worldsDir() / "jello.w");
+  text.replace(text.find('\n') + 1, 3, "x!y");
+  FILE* f = std::fopen(bad.c_str(), "w");
+  std::fputs(text.c_str(), f);
+  std::fclose(f);
+  const Outcome r = run(jello() + " " + bad.string());
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("bad.w:2"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("x!y"), std::string::npos) << r.output;
+}
+
+TEST(ViewerCommandLine, BadOptionsAreRefused) {
+  EXPECT_EQ(run(jello() + " --frames 301 --record /tmp/x").code, 2);
+  EXPECT_EQ(run(jello() + " --frames 10").code, 2);  // --frames needs --record
+  EXPECT_EQ(run(jello() + " --size 640by480").code, 2);
+  EXPECT_EQ(run(jello() + " --integrator leapfrog").code, 2);
+  const Outcome help = run(jello() + " --help");
+  EXPECT_EQ(help.code, 0);
+  for (const char* part : {"--record", "--frames", "--size", "ESC", "wireframe/shaded"}) {
+    EXPECT_NE(help.output.find(part), std::string::npos) << part;
+  }
+}
+
+TEST(ViewerCommandLine, WithoutADisplayItSaysHowToRecordHeadless) {
+  const Outcome r = run("env -u DISPLAY " + jello() + " " + world("jello.w"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("xvfb-run"), std::string::npos) << r.output;
+}
+
+TEST(ViewerCommandLine, AnUnwritableRecordingDirectoryIsReported) {
+  const Outcome r = run(headless(world("jello.w") + " --frames 2 --record /proc/jello-frames"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("/proc/jello-frames"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace jello::viewer
