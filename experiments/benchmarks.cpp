@@ -6,10 +6,10 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <string>
 
+#include "experiment_io.h"
 #include "runtime_environment.h"
 #include "scene_builder.h"
 #include "simulation.h"
@@ -59,24 +59,12 @@ BENCHMARK_CAPTURE(BM_Step, rk4, jello::IntegratorKind::RK4)->Arg(8)->Arg(16)->Ar
 BENCHMARK_CAPTURE(BM_Step, euler, jello::IntegratorKind::Euler)->Arg(8);
 BENCHMARK_CAPTURE(BM_Step, symplectic, jello::IntegratorKind::Symplectic)->Arg(8);
 
-// Which BLAS this process loaded (CHOLMOD's supernodal factorization depends on it).
-std::string loadedBlas() {
-  std::ifstream maps("/proc/self/maps");
-  for (std::string line; std::getline(maps, line);) {
-    for (const char* name : {"libopenblas", "libblis", "libmkl", "libblas.so"}) {
-      const auto at = line.find(name);
-      if (at != std::string::npos) return line.substr(line.find('/'));
-    }
-  }
-  return "none loaded";
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   // Single-threaded BLAS and CHOLMOD (see runtime_environment.h).
   jello::applyRuntimeEnvironment(argv);
-  benchmark::AddCustomContext("blas", loadedBlas());
+  benchmark::AddCustomContext("blas", jello::experiments::loadedBlas());
   benchmark::AddCustomContext("OPENBLAS_NUM_THREADS", std::getenv("OPENBLAS_NUM_THREADS"));
   benchmark::AddCustomContext("OMP_THREAD_LIMIT", std::getenv("OMP_THREAD_LIMIT"));
   benchmark::AddCustomContext("OMP_WAIT_POLICY", std::getenv("OMP_WAIT_POLICY"));

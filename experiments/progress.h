@@ -15,6 +15,10 @@ class Progress {
   void update(long done, long total) {
     if (enabled_ && (++calls_ & 255) == 0) draw(done, total);
   }
+  // The same without the call counter: for callers that report rarely (grid points).
+  void report(long done, long total) {
+    if (enabled_) draw(done, total);
+  }
   void finish();
 
  private:

@@ -10,5 +10,5 @@ scripts/build.sh "$preset"
 # Single-threaded BLAS and CHOLMOD, as jello-sim runs them (experiments/runtime_environment.h).
 export OMP_THREAD_LIMIT=${OMP_THREAD_LIMIT:-1} OPENBLAS_NUM_THREADS=${OPENBLAS_NUM_THREADS:-1}
 exclude=()
-[ "$preset" = asan ] && exclude=(--label-exclude "slow|soak")
+[ "$preset" = asan ] && exclude=(--label-exclude "slow|soak|experiments")
 ctest --preset "$preset" -j"$(nproc)" "${exclude[@]}"

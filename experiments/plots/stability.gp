@@ -1,0 +1,41 @@
+# Stability map from stability.csv: largest stable dt against k (measured points, predicted
+# lines), and the same thresholds in Courant numbers h*w_max.
+# gnuplot -e "dir='experiments/results'" experiments/plots/stability.gp
+if (!exists("dir")) dir = 'experiments/results'
+csv = dir.'/stability.csv'
+set datafile separator ','
+set logscale xy
+set format xy '10^{%L}'
+set grid
+set key outside right top
+set xlabel 'spring stiffness k (N/m)'
+sel(scene, integ, src) = sprintf("< awk -F, '$1==\"%s\" && $2==\"%s\" && $7==\"%s\"' %s", scene, integ, src, csv)
+m = 1.0/512
+integrators = "euler symplectic rk4 implicit cvode"
+colors = "#d62728 #2ca02c #1f77b4 #9467bd #ff7f0e"
+
+do for [scene in "free wall"] {
+  do for [fmt in "pngcairo svg"] {
+    if (fmt eq "pngcairo") { set terminal pngcairo size 900,560 font ",10"; set output dir.'/stability_'.scene.'.png' } \
+    else { set terminal svg size 900,560 font ",10"; set output dir.'/stability_'.scene.'.svg' }
+    set title 'Largest stable time step, '.scene.' scene (points measured, lines predicted)'
+    set ylabel 'dt (s)'
+    set yrange [1e-6:0.1]
+    plot for [i=1:3] sel(scene, word(integrators,i), 'predicted') using 3:8 with lines lw 2 lc rgb word(colors,i) title word(integrators,i).' predicted', \
+         for [i=1:3] sel(scene, word(integrators,i), 'measured') using 3:8 with points pt 7 ps 1.1 lc rgb word(colors,i) title word(integrators,i).' measured', \
+         sel(scene, 'implicit', 'measured') using 3:8 with points pt 4 ps 2.2 lw 2 lc rgb word(colors,4) title 'implicit: stable at the largest dt tried', \
+         sel(scene, 'cvode', 'measured') using 3:8 with points pt 7 ps 0.9 lc rgb word(colors,5) title 'cvode: stable at the largest dt tried', \
+         sqrt(m/x) with lines dt 2 lc rgb 'black' title 'Courant dt = sqrt(m/k)'
+    set output
+  }
+  do for [fmt in "pngcairo svg"] {
+    if (fmt eq "pngcairo") { set terminal pngcairo size 900,560 font ",10"; set output dir.'/courant_'.scene.'.png' } \
+    else { set terminal svg size 900,560 font ",10"; set output dir.'/courant_'.scene.'.svg' }
+    set title 'Thresholds in Courant numbers h w_{max}, '.scene.' scene'
+    set ylabel 'h w_{max}'
+    set yrange [0.005:10]
+    plot for [i=1:3] sel(scene, word(integrators,i), 'predicted') using 3:9 with lines lw 2 lc rgb word(colors,i) title word(integrators,i).' predicted', \
+         for [i=1:3] sel(scene, word(integrators,i), 'measured') using 3:9 with points pt 7 ps 1.1 lc rgb word(colors,i) title word(integrators,i).' measured'
+    set output
+  }
+}

@@ -1,0 +1,74 @@
+// The stability experiment's physics: the fastest mode of a scene, each integrator's predicted
+// largest stable time step, the tested definition of "blew up", and the bisection that
+// measures the threshold.
+//
+// Linearized at the start state, the modes have w_j^2 = eig(-K/m) (uniform point mass m, so
+// M^-1/2 (-K) M^-1/2 = -K/m; K includes contact springs in touch). Spectra's Lanczos solver
+// finds the largest, w_max: a general eigen-solver is thrown off by the six rigid modes at 0.
+// Spring damping c = r k gives every mode the damping ratio zeta = r w / 2 (physics.md): the
+// mode's eigenvalues are lambda = w (-zeta +- i sqrt(1 - zeta^2)) (real when zeta > 1). A
+// method is stable at h when every mode w in (0, w_max] has amplification spectral radius <= 1:
+//   euler      R = 1 + z                                    (h <= r exactly when zeta <= 1)
+//   rk4        R = 1 + z + z^2/2 + z^3/6 + z^4/24           (h w <= 2 sqrt 2 undamped)
+//   symplectic the 2x2 map v' = v + h a(x, v), x' = x + h v' (h w < 2 undamped)
+// with z = h lambda. implicit (backward Euler) and cvode (adaptive BDF) have no such limit.
+#pragma once
+
+#include <limits>
+#include <string>
+#include <string_view>
+
+#include "integrator_name.h"
+#include "model.h"
+#include "solver_options.h"
+#include "world.h"
+
+namespace jello::experiments {
+
+// sqrt of the largest eigenvalue of -K/m at `state` (rad/s); K is the exact (unclamped) spring
+// and contact Jacobian. Throws std::runtime_error when Spectra does not converge.
+double maxAngularFrequency(const Model& model, const State& state);
+
+// The largest h at which `kind` is stable on every mode up to wMax with damping ratio
+// r * w / 2 (r = c/k in s); 0 when never stable, +infinity for implicit and cvode.
+double predictedThreshold(IntegratorKind kind, double wMax, double dampingRatio);
+
+// The standard scenes, spring damping c = r k:
+//   "free": the cube at rest with its far corner pulled out by one spacing, in the middle of the
+//           box, touching nothing (the walls are never reached);
+//   "wall": the same cube under gravity resting on the floor, its bottom layer pressed in by
+//           the static load of its column, with contact springs contactRatio times stiffer
+//           than the lattice's (kCollision = contactRatio k, dCollision = r kCollision): the
+//           contact mode, not the lattice, sets w_max, and it stays in contact.
+World stabilityScene(std::string_view scene, double k, double dampingRatio,
+                     double contactRatio = 20.0);
+
+// "Blew up": within `time` simulated seconds, a step produced a non-finite or far state (the
+// simulation's divergence check, bound 100 m) or the total energy (kinetic + spring + contact)
+// rose above energyFactor times its start.
+struct BlowUpRule {
+  double time = 0.2;          // s
+  double energyFactor = 10.0;
+};
+
+struct Trial {
+  bool blewUp = false;
+  std::string reason;
+  long steps = 0;
+};
+Trial runTrial(const World& world, IntegratorKind kind, double dt, const BlowUpRule& rule,
+               const SolverOptions& options = {});
+
+struct Threshold {
+  double stable = 0.0;  // s, largest dt seen stable (0: none down to dtMin)
+  double unstable = std::numeric_limits<double>::infinity();  // s, smallest seen to blow up
+  int trials = 0;
+  bool stableToMax() const { return std::isinf(unstable); }
+};
+// First tries dtMax; if it blows up, brackets downward from `guess` by factors of 2 (not below
+// dtMin), then bisects geometrically until unstable/stable <= 1 + relativeTolerance.
+Threshold findThreshold(const World& world, IntegratorKind kind, const BlowUpRule& rule,
+                        double guess, double dtMax, double relativeTolerance = 0.02,
+                        double dtMin = 1e-8, const SolverOptions& options = {});
+
+}  // namespace jello::experiments

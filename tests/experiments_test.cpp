@@ -1,0 +1,216 @@
+// The experiments: the stability analysis against closed forms, the tested definition of
+// "blew up", and --quick runs of each program whose CSV must hold the physics the README
+// states (thresholds near their predictions, flat Courant numbers, convergence orders).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <sstream>
+
+#include "scene_builder.h"
+#include "stability_analysis.h"
+#include "test_support.h"
+
+namespace jello::experiments {
+namespace {
+
+TEST(StabilityAnalysis, WMaxOfTheLatticeAtRestIsTheDenseSolvesValue) {
+  // physics.md: w_max = 4.0715 sqrt(k/m) for the full 8^3 lattice at rest.
+  World w = buildWorld(stiffCube(1e4));
+  const Lattice lattice{8};
+  for (int i = 0; i < 8; ++i) {
+    for (int j = 0; j < 8; ++j) {
+      for (int k = 0; k < 8; ++k) w.positions[lattice.index(i, j, k)] = lattice.restPosition(i, j, k);
+    }
+  }
+  const double wMax = maxAngularFrequency(Model(w), initialState(w));
+  EXPECT_NEAR(wMax / std::sqrt(1e4 / w.mass), 4.0715, 5e-4);
+}
+
+TEST(StabilityAnalysis, PredictedThresholdsMatchTheClosedForms) {
+  const double w = 1000.0;
+  EXPECT_NEAR(predictedThreshold(IntegratorKind::RK4, w, 0.0) * w, 2.0 * std::numbers::sqrt2, 1e-6);
+  EXPECT_NEAR(predictedThreshold(IntegratorKind::Symplectic, w, 0.0) * w, 2.0, 1e-6);
+  EXPECT_EQ(predictedThreshold(IntegratorKind::Euler, w, 0.0), 0.0);  // never stable undamped
+  // Damped (zeta_max = r w / 2 = 0.25 < 1): forward Euler is stable exactly for h <= r = c/k.
+  EXPECT_NEAR(predictedThreshold(IntegratorKind::Euler, w, 5e-4), 5e-4, 1e-9);
+  EXPECT_TRUE(std::isinf(predictedThreshold(IntegratorKind::Implicit, w, 0.0)));
+  EXPECT_TRUE(std::isinf(predictedThreshold(IntegratorKind::Cvode, w, 0.0)));
+  // Strongly damped real modes: RK4's limit on the negative real axis is 2.785 / |lambda|.
+  const double r = 0.02, zeta = r * w / 2.0, lambda = w * (zeta + std::sqrt(zeta * zeta - 1.0));
+  EXPECT_NEAR(predictedThreshold(IntegratorKind::RK4, w, r) * lambda, 2.785, 0.01);
+}
+
+TEST(StabilityAnalysis, BlewUpMeansDivergedOrTenfoldEnergyWithinTheRunTime) {
+  const World w = stabilityScene("free", 1e4, 1e-5);
+  const double wMax = maxAngularFrequency(Model(w), initialState(w));
+  const double limit = predictedThreshold(IntegratorKind::RK4, wMax, 1e-5);
+  const BlowUpRule rule{0.1, 10.0};
+  EXPECT_FALSE(runTrial(w, IntegratorKind::RK4, 0.9 * limit, rule).blewUp);
+  const Trial above = runTrial(w, IntegratorKind::RK4, 1.2 * limit, rule);
+  EXPECT_TRUE(above.blewUp);
+  EXPECT_LT(above.steps, std::lround(0.1 / (1.2 * limit)));
+  // A huge factor leaves only the divergence check: still caught, later.
+  const Trial diverged = runTrial(w, IntegratorKind::RK4, 1.2 * limit, {0.1, 1e300});
+  EXPECT_TRUE(diverged.blewUp);
+  EXPECT_NE(diverged.reason.find("diverged"), std::string::npos) << diverged.reason;
+  EXPECT_GT(diverged.steps, above.steps);
+}
+
+TEST(StabilityAnalysis, TheWallSceneRestsOnTheFloorInContact) {
+  const World w = stabilityScene("wall", 1e4, 1e-5);
+  double lowest = 1e9;
+  for (const Vec3& p : w.positions) lowest = std::min(lowest, p.z);
+  EXPECT_LT(lowest, -2.0);
+  EXPECT_GT(lowest, -2.001);
+  EXPECT_EQ(w.kCollision, 20.0 * 1e4);
+  // The contact springs raise w_max above the free cube's.
+  const World free = stabilityScene("free", 1e4, 1e-5);
+  EXPECT_GT(maxAngularFrequency(Model(w), initialState(w)),
+            1.1 * maxAngularFrequency(Model(free), initialState(free)));
+}
+
+// --- the programs' --quick runs ---------------------------------------------------------------
+
+using Table = std::vector<std::map<std::string, std::string>>;
+
+Table readCsv(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::vector<std::string> columns;
+  Table rows;
+  const auto split = [](const std::string& s) {
+    std::vector<std::string> out;
+    std::stringstream ss(s);
+    for (std::string cell; std::getline(ss, cell, ',');) out.push_back(cell);
+    return out;
+  };
+  if (std::getline(in, line)) columns = split(line);
+  while (std::getline(in, line)) {
+    const auto cells = split(line);
+    std::map<std::string, std::string> row;
+    for (std::size_t i = 0; i < columns.size() && i < cells.size(); ++i) row[columns[i]] = cells[i];
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+int run(const std::string& command) {
+  const int status = std::system((command + " --quiet > /dev/null 2>&1").c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+double number(const std::map<std::string, std::string>& row, const std::string& column) {
+  return std::stod(row.at(column));
+}
+
+void expectSidecar(const std::filesystem::path& path, const char* program) {
+  std::ifstream in(path);
+  ASSERT_TRUE(in) << path;
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j.at("program"), program);
+  for (const char* key : {"command_line", "commit", "compiler", "blas", "machine", "parameters",
+                          "date_utc", "wall_time_s"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+}
+
+// Least-squares slope of log(error) against log(dt).
+double slope(const std::vector<std::pair<double, double>>& points) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (auto [dt, e] : points) {
+    const double x = std::log(dt), y = std::log(e);
+    sx += x, sy += y, sxx += x * x, sxy += x * y;
+  }
+  const double n = double(points.size());
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+TEST(StabilityMapQuick, ThresholdsMeetTheirPredictionsAndImplicitNeverBlowsUp) {
+  test::TempDir dir;
+  ASSERT_EQ(run(std::string(JELLO_STABILITY) + " --quick --out-dir " + dir.path().string()), 0);
+  const Table rows = readCsv(dir.path() / "stability.csv");
+  expectSidecar(dir.path() / "stability.json", "jello-stability");
+  ASSERT_EQ(rows.size(), 2u * 5u * 2u);  // 2 k x 5 integrators x (predicted, measured)
+  std::map<std::string, double> predicted;
+  std::map<std::string, std::vector<double>> courant;
+  for (const auto& r : rows) {
+    if (r.at("source") == "predicted") predicted[r.at("integrator") + r.at("k_N_per_m")] = number(r, "dt_s");
+  }
+  for (const auto& r : rows) {
+    if (r.at("source") != "measured") continue;
+    const std::string integrator = r.at("integrator");
+    if (integrator == "rk4" || integrator == "symplectic") {
+      const double ratio = number(r, "dt_s") / predicted.at(integrator + r.at("k_N_per_m"));
+      EXPECT_NEAR(ratio, 1.0, 0.25) << integrator << " at k = " << r.at("k_N_per_m");
+      courant[integrator].push_back(number(r, "courant_number"));
+    }
+    if (integrator == "implicit") {
+      EXPECT_EQ(r.at("outcome"), "stable_to_max") << r.at("k_N_per_m");
+    }
+  }
+  const auto& c = courant["rk4"];
+  ASSERT_EQ(c.size(), 2u);
+  EXPECT_LT(*std::max_element(c.begin(), c.end()) / *std::min_element(c.begin(), c.end()), 1.25);
+}
+
+TEST(WorkPrecisionQuick, ErrorsFallWithTheMethodsOrders) {
+  test::TempDir dir;
+  ASSERT_EQ(run(std::string(JELLO_WORK_PRECISION) + " --quick --out-dir " + dir.path().string()),
+            0);
+  expectSidecar(dir.path() / "work_precision.json", "jello-work-precision");
+  std::map<std::string, std::vector<std::pair<double, double>>> errors;
+  std::vector<std::pair<double, double>> cvode5;
+  for (const auto& r : readCsv(dir.path() / "work_precision.csv")) {
+    EXPECT_GT(number(r, "wall_time_s"), 0.0);
+    const double e = number(r, "position_error_m");
+    if (r.at("integrator") == "cvode") {
+      if (r.at("cvode_max_order") == "5") cvode5.emplace_back(number(r, "rtol"), e);
+    } else {
+      errors[r.at("integrator")].emplace_back(number(r, "dt_s"), e);
+    }
+  }
+  ASSERT_EQ(errors["rk4"].size(), 3u);
+  EXPECT_NEAR(slope(errors["euler"]), 1.0, 0.35);
+  EXPECT_NEAR(slope(errors["implicit"]), 1.0, 0.35);
+  EXPECT_NEAR(slope(errors["symplectic"]), 1.0, 0.35);
+  EXPECT_NEAR(slope(errors["rk4"]), 4.0, 0.6);
+  std::sort(cvode5.begin(), cvode5.end());
+  ASSERT_EQ(cvode5.size(), 3u);
+  EXPECT_LT(cvode5[0].second, cvode5[2].second);  // tighter tolerance, smaller error
+  const Table damping = readCsv(dir.path() / "work_precision_damping.csv");
+  ASSERT_FALSE(damping.empty());
+  for (const auto& r : damping) EXPECT_GT(number(r, "energy_decay_rate_per_s"), 0.0);
+}
+
+TEST(ScalingQuick, EveryIntegratorAndSizeHasItsCostAndTheImplicitSplit) {
+  test::TempDir dir;
+  ASSERT_EQ(run(std::string(JELLO_SCALING) + " --quick --out-dir " + dir.path().string()), 0);
+  expectSidecar(dir.path() / "scaling.json", "jello-scaling");
+  const Table rows = readCsv(dir.path() / "scaling.csv");
+  EXPECT_EQ(rows.size(), 2u * 7u);  // N = 6, 8 x (3 explicit + implicit and cvode x 2 solvers)
+  for (const auto& r : rows) {
+    const double n = number(r, "n");
+    EXPECT_EQ(number(r, "unknowns"), 3 * n * n * n);
+    const double cost = number(r, "wall_per_simulated_s");
+    EXPECT_TRUE(std::isfinite(cost) && cost > 0.0);
+    if (r.at("integrator") == "implicit") {
+      EXPECT_LE(number(r, "factor_per_simulated_s") + number(r, "solve_per_simulated_s"), cost);
+    }
+  }
+}
+
+TEST(ExperimentPrograms, RefuseBadArguments) {
+  EXPECT_EQ(run(std::string(JELLO_STABILITY) + " --integrators leapfrog"), 2);
+  EXPECT_EQ(run(std::string(JELLO_STABILITY) + " --k -5"), 2);
+  EXPECT_EQ(run(std::string(JELLO_WORK_PRECISION) + " --levels 1"), 2);
+  EXPECT_EQ(run(std::string(JELLO_SCALING) + " --n 1"), 2);
+  EXPECT_EQ(run(std::string(JELLO_SCALING) + " --quick --out-dir /proc/jello"), 1);
+}
+
+}  // namespace
+}  // namespace jello::experiments
