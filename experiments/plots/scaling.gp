@@ -10,6 +10,7 @@ set xlabel 'cube resolution N (N^3 points)'
 set ylabel 'wall seconds per simulated second'
 sel(integ, solver) = sprintf("< awk -F, '$4==\"%s\" && $5==\"%s\"' %s | sort -t, -k1,1n", integ, solver, csv)
 set xtics (6, 8, 12, 16, 24, 32)
+set xrange [5.5:36]
 do for [fmt in "pngcairo svg"] {
   if (fmt eq "pngcairo") { set terminal pngcairo size 900,560 font ",10"; set output dir.'/scaling.png' } \
   else { set terminal svg size 900,560 font ",10"; set output dir.'/scaling.svg' }
