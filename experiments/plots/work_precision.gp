@@ -32,7 +32,7 @@ damping = dir.'/work_precision_damping.csv'
 do for [fmt in "pngcairo svg"] {
   if (fmt eq "pngcairo") { set terminal pngcairo size 760,480 font ",10"; set output dir.'/implicit_damping.png' } \
   else { set terminal svg size 760,480 font ",10"; set output dir.'/implicit_damping.svg' }
-  set title "Backward Euler's artificial damping: undamped stiff cube (k = 10^4), 0.2 s"
+  set title "Backward Euler's artificial damping: undamped stiff cube (k = 10^4), first 0.02 s"
   set xlabel 'dt (s)'
   set ylabel 'energy decay rate ln(E_0/E)/T (1/s)'
   unset key
