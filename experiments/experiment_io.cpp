@@ -94,20 +94,22 @@ nlohmann::json runContext(int argc, char** argv) {
   const std::time_t now = std::time(nullptr);
   char date[32];
   std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
-  return {{"command_line", args},
-          {"commit", commit.empty() ? "unknown" : commit},
-          {"tree_modified", dirty},
-          {"compiler", std::string(__VERSION__)},
-          {"build_type", JELLO_BUILD_TYPE},
-          {"blas", loadedBlas()},
-          {"OPENBLAS_NUM_THREADS", std::getenv("OPENBLAS_NUM_THREADS") ? std::getenv("OPENBLAS_NUM_THREADS") : ""},
-          {"OMP_THREAD_LIMIT", std::getenv("OMP_THREAD_LIMIT") ? std::getenv("OMP_THREAD_LIMIT") : ""},
-          {"machine",
-           {{"cpu", cpuModel()},
-            {"cores", std::thread::hardware_concurrency()},
-            {"kernel", named ? std::string(u.sysname) + " " + u.release : "unknown"},
-            {"arch", named ? u.machine : "unknown"}}},
-          {"date_utc", date}};
+  return {
+      {"command_line", args},
+      {"commit", commit.empty() ? "unknown" : commit},
+      {"tree_modified", dirty},
+      {"compiler", std::string(__VERSION__)},
+      {"build_type", JELLO_BUILD_TYPE},
+      {"blas", loadedBlas()},
+      {"OPENBLAS_NUM_THREADS",
+       std::getenv("OPENBLAS_NUM_THREADS") ? std::getenv("OPENBLAS_NUM_THREADS") : ""},
+      {"OMP_THREAD_LIMIT", std::getenv("OMP_THREAD_LIMIT") ? std::getenv("OMP_THREAD_LIMIT") : ""},
+      {"machine",
+       {{"cpu", cpuModel()},
+        {"cores", std::thread::hardware_concurrency()},
+        {"kernel", named ? std::string(u.sysname) + " " + u.release : "unknown"},
+        {"arch", named ? u.machine : "unknown"}}},
+      {"date_utc", date}};
 }
 
 void writeSidecar(const std::filesystem::path& path, const nlohmann::json& sidecar) {

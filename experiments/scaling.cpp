@@ -48,19 +48,24 @@ int main(int argc, char** argv) {
   std::string outDir = "experiments/results", name = "scaling";
   CLI::App app{"jello-scaling: wall time per simulated second against cube resolution"};
   app.add_option("--n", ns, "Cube resolutions")->check(CLI::Range(2, 64))->delimiter(',');
-  app.add_option("--k", k, "Spring stiffness, N/m")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--k", k, "Spring stiffness, N/m")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("--budget", budget, "Wall seconds to run each point for (at least one step)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--implicit-dt", implicitDt, "Time step of implicit, output interval of cvode, s")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--rtol", rtol, "cvode's relative tolerance")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--rtol", rtol, "cvode's relative tolerance")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("--jobs", jobs,
                  "Points run in parallel (1 gives timings free of a neighbour's memory traffic)")
       ->check(CLI::Range(1, 256))
       ->capture_default_str();
-  app.add_option("--out-dir", outDir, "Directory for NAME.csv and NAME.json")->capture_default_str();
+  app.add_option("--out-dir", outDir, "Directory for NAME.csv and NAME.json")
+      ->capture_default_str();
   app.add_option("--name", name, "File name stem")->capture_default_str();
   app.add_option("--cvode-cholmod-max-n", cvodeDirectMaxN,
                  "Largest N for cvode with CHOLMOD (one output interval there needs several "
@@ -80,8 +85,8 @@ int main(int argc, char** argv) {
 
   std::vector<Task> tasks;
   for (int n : ns) {
-    for (IntegratorKind kind : {IntegratorKind::Euler, IntegratorKind::Symplectic,
-                                IntegratorKind::RK4}) {
+    for (IntegratorKind kind :
+         {IntegratorKind::Euler, IntegratorKind::Symplectic, IntegratorKind::RK4}) {
       tasks.push_back({n, kind});
     }
     for (IntegratorKind kind : {IntegratorKind::Implicit, IntegratorKind::Cvode}) {
@@ -95,12 +100,13 @@ int main(int argc, char** argv) {
     }
   }
   // Largest first, so a parallel run does not end on one long point.
-  std::stable_sort(tasks.begin(), tasks.end(), [](const Task& a, const Task& b) { return a.n > b.n; });
+  std::stable_sort(tasks.begin(), tasks.end(),
+                   [](const Task& a, const Task& b) { return a.n > b.n; });
 
   CsvTable table({"n", "points", "unknowns", "integrator", "linear_solver", "k_N_per_m",
                   "w_max_rad_per_s", "dt_s", "steps", "simulated_s", "wall_s",
-                  "wall_per_simulated_s", "assemble_per_simulated_s",
-                  "factor_per_simulated_s", "solve_per_simulated_s", "factorizations"});
+                  "wall_per_simulated_s", "assemble_per_simulated_s", "factor_per_simulated_s",
+                  "solve_per_simulated_s", "factorizations"});
   const auto started = Clock::now();
   try {
     parallelFor(int(tasks.size()), jobs, "points", !quiet, [&](int i) {
@@ -136,10 +142,9 @@ int main(int argc, char** argv) {
       };
       table.add({long(t.n), long(w.numPoints()), long(3 * w.numPoints()),
                  std::string(integratorName(t.kind)),
-                 std::string(split ? linearSolverName(t.solver) : "none"), k, wMax, dt,
-                 sim.steps(), simulated, wall, wall / simulated,
-                 perSecond("assemble_time_s"), perSecond("factor_time_s"),
-                 perSecond("solve_time_s"),
+                 std::string(split ? linearSolverName(t.solver) : "none"), k, wMax, dt, sim.steps(),
+                 simulated, wall, wall / simulated, perSecond("assemble_time_s"),
+                 perSecond("factor_time_s"), perSecond("solve_time_s"),
                  split ? statistic(integ, "factorizations") : std::nan("")});
     });
   } catch (const std::exception& e) {
@@ -148,16 +153,17 @@ int main(int argc, char** argv) {
   }
   nlohmann::json sidecar = runContext(argc, argv);
   sidecar["program"] = "jello-scaling";
-  sidecar["parameters"] = {{"n", ns},
-                           {"k_N_per_m", k},
-                           {"scene", "stiff cube stretched 5% along x, spinning 2 rad/s, c = 0.25 N*s/m"},
-                           {"explicit_dt", "0.9 times the predicted stability limit"},
-                           {"implicit_dt_s", implicitDt},
-                           {"cvode_rtol", rtol},
-                           {"cvode_cholmod_max_n", cvodeDirectMaxN},
-                           {"budget_s", budget},
-                           {"jobs", jobs},
-                           {"quick", quick}};
+  sidecar["parameters"] = {
+      {"n", ns},
+      {"k_N_per_m", k},
+      {"scene", "stiff cube stretched 5% along x, spinning 2 rad/s, c = 0.25 N*s/m"},
+      {"explicit_dt", "0.9 times the predicted stability limit"},
+      {"implicit_dt_s", implicitDt},
+      {"cvode_rtol", rtol},
+      {"cvode_cholmod_max_n", cvodeDirectMaxN},
+      {"budget_s", budget},
+      {"jobs", jobs},
+      {"quick", quick}};
   sidecar["wall_time_s"] = std::chrono::duration<double>(Clock::now() - started).count();
   const std::filesystem::path dir = outDir;
   try {

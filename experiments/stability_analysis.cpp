@@ -92,8 +92,7 @@ double predictedThreshold(IntegratorKind kind, double wMax, double dampingRatio)
   return lo;
 }
 
-World stabilityScene(std::string_view scene, double k, double dampingRatio,
-                     double contactRatio) {
+World stabilityScene(std::string_view scene, double k, double dampingRatio, double contactRatio) {
   SceneSpec spec = stiffCube(k);
   spec.dElastic = dampingRatio * k;
   spec.pose = PosePreset::SkewedCorner;

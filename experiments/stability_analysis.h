@@ -47,7 +47,7 @@ World stabilityScene(std::string_view scene, double k, double dampingRatio,
 // simulation's divergence check, bound 100 m) or the total energy (kinetic + spring + contact)
 // rose above energyFactor times its start.
 struct BlowUpRule {
-  double time = 0.2;          // s
+  double time = 0.2;  // s
   double energyFactor = 10.0;
 };
 

@@ -47,8 +47,9 @@ struct Point {
 int main(int argc, char** argv) {
   applyRuntimeEnvironment(argv);
   Options opt;
-  CLI::App app{"jello-stability: largest stable time step per integrator and stiffness, "
-               "measured against predicted"};
+  CLI::App app{
+      "jello-stability: largest stable time step per integrator and stiffness, "
+      "measured against predicted"};
   app.add_option("--k", opt.ks, "Spring stiffnesses, N/m (default 10 to 1e6, 2 per decade)")
       ->check(CLI::PositiveNumber)
       ->delimiter(',');
@@ -129,9 +130,8 @@ int main(int argc, char** argv) {
     return 1;
   }
 
-  CsvTable table({"scene", "integrator", "k_N_per_m", "c_Ns_per_m", "w_max_rad_per_s",
-                  "zeta_max", "source", "dt_s", "courant_number", "outcome", "trials",
-                  "wall_time_s"});
+  CsvTable table({"scene", "integrator", "k_N_per_m", "c_Ns_per_m", "w_max_rad_per_s", "zeta_max",
+                  "source", "dt_s", "courant_number", "outcome", "trials", "wall_time_s"});
   SolverOptions solver;
   solver.cvode.rtol = opt.rtol;
   const int tasks = int(points.size() * kinds.size());
@@ -146,17 +146,20 @@ int main(int argc, char** argv) {
       table.add({p.scene, name, p.k, c, p.wMax, zeta, std::string("predicted"), predicted,
                  predicted * p.wMax,
                  std::string(std::isinf(predicted) ? "unconditional"
-                                                   : predicted > 0.0 ? "limit" : "never"),
+                             : predicted > 0.0     ? "limit"
+                                                   : "never"),
                  0L, 0.0});
       // The search starts at Courant number 1 for every method, not at its prediction, so the
       // measurement does not lean on what it is compared with.
       const double guess = 1.0 / p.wMax;
       const auto t0 = std::chrono::steady_clock::now();
-      const Threshold t = findThreshold(p.world, kind, opt.rule, guess, opt.dtMax, opt.tolerance,
-                                        1e-8, solver);
-      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      const std::string outcome =
-          t.stableToMax() ? "stable_to_max" : t.stable > 0.0 ? "threshold" : "unstable_to_min";
+      const Threshold t =
+          findThreshold(p.world, kind, opt.rule, guess, opt.dtMax, opt.tolerance, 1e-8, solver);
+      const double wall =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const std::string outcome = t.stableToMax()  ? "stable_to_max"
+                                  : t.stable > 0.0 ? "threshold"
+                                                   : "unstable_to_min";
       table.add({p.scene, name, p.k, c, p.wMax, zeta, std::string("measured"), t.stable,
                  t.stable * p.wMax, outcome, long(t.trials), wall});
     });
@@ -171,9 +174,10 @@ int main(int argc, char** argv) {
                            {"scenes", opt.scenes},
                            {"damping_ratio_s", opt.dampingRatio},
                            {"wall_contact_ratio", opt.contactRatio},
-                           {"blow_up", {{"time_s", opt.rule.time},
-                                        {"energy_factor", opt.rule.energyFactor},
-                                        {"divergence_bound_m", kDivergenceBound}}},
+                           {"blow_up",
+                            {{"time_s", opt.rule.time},
+                             {"energy_factor", opt.rule.energyFactor},
+                             {"divergence_bound_m", kDivergenceBound}}},
                            {"bisection_tolerance", opt.tolerance},
                            {"dt_max_s", opt.dtMax},
                            {"cvode_rtol", opt.rtol},

@@ -78,9 +78,9 @@ double positionError(const State& a, const State& b) {
 struct Task {
   std::size_t scene;
   IntegratorKind kind;
-  double dt = 0.0;   // s (cvode: the output interval, the whole span)
-  double rtol = 0.0; // cvode only
-  int maxOrder = 0;  // cvode only
+  double dt = 0.0;    // s (cvode: the output interval, the whole span)
+  double rtol = 0.0;  // cvode only
+  int maxOrder = 0;   // cvode only
 };
 
 }  // namespace
@@ -90,10 +90,10 @@ int main(int argc, char** argv) {
   int levels = 7, jobs = int(std::max(1u, std::thread::hardware_concurrency()));
   double stiffK = 1e4;
   bool quick = false, quiet = false;
-  std::string outDir = "experiments/results", name = "work_precision",
-              worldsDir = JELLO_WORLDS_DIR;
-  CLI::App app{"jello-work-precision: error against wall time per integrator, and backward "
-               "Euler's artificial damping"};
+  std::string outDir = "experiments/results", name = "work_precision", worldsDir = JELLO_WORLDS_DIR;
+  CLI::App app{
+      "jello-work-precision: error against wall time per integrator, and backward "
+      "Euler's artificial damping"};
   app.add_option("--levels", levels, "Time steps per integrator (halving from its largest)")
       ->check(CLI::Range(2, 12))
       ->capture_default_str();
@@ -101,11 +101,15 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--worlds", worldsDir, "Directory holding jello.w")->capture_default_str();
-  app.add_option("--jobs", jobs, "Runs in parallel")->check(CLI::Range(1, 256))->capture_default_str();
-  app.add_option("--out-dir", outDir, "Directory for NAME.csv and NAME.json")->capture_default_str();
+  app.add_option("--jobs", jobs, "Runs in parallel")
+      ->check(CLI::Range(1, 256))
+      ->capture_default_str();
+  app.add_option("--out-dir", outDir, "Directory for NAME.csv and NAME.json")
+      ->capture_default_str();
   app.add_option("--name", name, "File name stem")->capture_default_str();
-  app.add_flag("--quick", quick,
-               "CI: the soft scene only, 3 levels per method in its asymptotic range, 3 tolerances");
+  app.add_flag(
+      "--quick", quick,
+      "CI: the soft scene only, 3 levels per method in its asymptotic range, 3 tolerances");
   app.add_flag("--quiet", quiet, "No progress line");
   try {
     app.parse(argc, argv);
@@ -130,12 +134,18 @@ int main(int argc, char** argv) {
     if (!quick) list.emplace_back("stiff", stiffScene(stiffK, 0.25), 0.04);
     for (auto& [label, w, time] : list) {
       const Model model(w);
-      Scene s{label, w, time, w.kElastic > 0 ? w.dElastic / w.kElastic : 0.0,
-              maxAngularFrequency(model, initialState(w)), {}, 0.0};
+      Scene s{label,
+              w,
+              time,
+              w.kElastic > 0 ? w.dElastic / w.kElastic : 0.0,
+              maxAngularFrequency(model, initialState(w)),
+              {},
+              0.0};
       s.reference = simulate(w, IntegratorKind::Cvode, time, time, referenceOptions).end;
       // The reference checked against RK4 at a step far below its limit.
       const double tiny = time / std::pow(2.0, std::ceil(std::log2(time * s.wMax / 0.05)));
-      s.referenceCheck = positionError(simulate(w, IntegratorKind::RK4, tiny, time, {}).end, s.reference);
+      s.referenceCheck =
+          positionError(simulate(w, IntegratorKind::RK4, tiny, time, {}).end, s.reference);
       scenes.push_back(std::move(s));
     }
   } catch (const std::exception& e) {
@@ -159,7 +169,7 @@ int main(int argc, char** argv) {
       for (int l = 0; l < count; ++l, dt /= 2.0) tasks.push_back({s, kind, dt});
     }
     for (int order : {2, 5}) {
-        for (double rtol : rtols) {
+      for (double rtol : rtols) {
         // BDF2 at the tightest tolerance takes minutes on the stiff cube; order 5 covers it.
         if (order == 2 && rtol < 1e-7 && scenes[s].name == "stiff") continue;
         tasks.push_back({s, IntegratorKind::Cvode, scenes[s].time, rtol, order});
@@ -176,8 +186,8 @@ int main(int argc, char** argv) {
     dampingSteps.push_back(dt);
   }
 
-  CsvTable table({"scene", "integrator", "cvode_max_order", "dt_s", "rtol", "steps",
-                  "wall_time_s", "position_error_m", "energy_relative_error"});
+  CsvTable table({"scene", "integrator", "cvode_max_order", "dt_s", "rtol", "steps", "wall_time_s",
+                  "position_error_m", "energy_relative_error"});
   CsvTable damping({"scene", "integrator", "dt_s", "h_w_max", "steps", "energy_start_J",
                     "energy_end_J", "energy_loss_J_per_s", "energy_decay_rate_per_s"});
   const int total = int(tasks.size() + dampingSteps.size());
@@ -206,8 +216,8 @@ int main(int argc, char** argv) {
       const Run r = simulate(s.world, t.kind, t.dt, s.time, options);
       const Model model(s.world);
       const double eRef = model.energy(s.reference).total(), e = model.energy(r.end).total();
-      table.add({s.name, std::string(integratorName(t.kind)), long(t.maxOrder), t.dt,
-                 t.rtol, r.steps, r.seconds, positionError(r.end, s.reference),
+      table.add({s.name, std::string(integratorName(t.kind)), long(t.maxOrder), t.dt, t.rtol,
+                 r.steps, r.seconds, positionError(r.end, s.reference),
                  std::abs(e - eRef) / std::abs(eRef)});
     });
   } catch (const std::exception& e) {
@@ -231,7 +241,9 @@ int main(int argc, char** argv) {
                            {"levels", levels},
                            {"cvode_rtols", rtols},
                            {"damping_scene",
-                            {{"k_N_per_m", stiffK}, {"c_Ns_per_m", 0.0}, {"time_s", dampingTime},
+                            {{"k_N_per_m", stiffK},
+                             {"c_Ns_per_m", 0.0},
+                             {"time_s", dampingTime},
                              {"pose", "stretched 5% along x, at rest"}}},
                            {"jobs", jobs},
                            {"quick", quick},
@@ -249,8 +261,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (!quiet) {
-    std::printf("wrote %zu + %zu rows to %s (%.1f s)\n", table.rows(), damping.rows(),
-                dir.c_str(), sidecar["wall_time_s"].get<double>());
+    std::printf("wrote %zu + %zu rows to %s (%.1f s)\n", table.rows(), damping.rows(), dir.c_str(),
+                sidecar["wall_time_s"].get<double>());
   }
   return 0;
 }

@@ -24,7 +24,8 @@ TEST(StabilityAnalysis, WMaxOfTheLatticeAtRestIsTheDenseSolvesValue) {
   const Lattice lattice{8};
   for (int i = 0; i < 8; ++i) {
     for (int j = 0; j < 8; ++j) {
-      for (int k = 0; k < 8; ++k) w.positions[lattice.index(i, j, k)] = lattice.restPosition(i, j, k);
+      for (int k = 0; k < 8; ++k)
+        w.positions[lattice.index(i, j, k)] = lattice.restPosition(i, j, k);
     }
   }
   const double wMax = maxAngularFrequency(Model(w), initialState(w));
@@ -139,7 +140,8 @@ TEST(StabilityMapQuick, ThresholdsMeetTheirPredictionsAndImplicitNeverBlowsUp) {
   std::map<std::string, double> predicted;
   std::map<std::string, std::vector<double>> courant;
   for (const auto& r : rows) {
-    if (r.at("source") == "predicted") predicted[r.at("integrator") + r.at("k_N_per_m")] = number(r, "dt_s");
+    if (r.at("source") == "predicted")
+      predicted[r.at("integrator") + r.at("k_N_per_m")] = number(r, "dt_s");
   }
   for (const auto& r : rows) {
     if (r.at("source") != "measured") continue;

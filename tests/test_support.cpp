@@ -1,6 +1,9 @@
 #include "test_support.h"
 
+#include <sys/wait.h>
+
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -15,6 +18,16 @@ std::filesystem::path worldsDir() {
 
 World loadWorld(const std::string& name) {
   return readWorld(worldsDir() / name);
+}
+
+Outcome run(const std::string& command) {
+  std::string output;
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return {-1, "popen failed"};
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) output.append(buf, n);
+  const int status = ::pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
 }
 
 std::string readFile(const std::filesystem::path& path) {

@@ -14,6 +14,14 @@ std::filesystem::path worldsDir();
 World loadWorld(const std::string& name);  // a file of worlds/
 std::string readFile(const std::filesystem::path& path);
 
+// A program run through the shell: its exit code (-1 when it did not exit normally) and its
+// standard output and error together.
+struct Outcome {
+  int code;
+  std::string output;
+};
+Outcome run(const std::string& command);
+
 // A fresh, empty directory under the system temp dir, removed when the object dies.
 class TempDir {
  public:

@@ -17,20 +17,8 @@
 namespace jello::viewer {
 namespace {
 
-struct Outcome {
-  int code;
-  std::string output;
-};
-
-Outcome run(const std::string& command) {
-  std::string output;
-  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return {-1, "popen failed"};
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) output.append(buf, n);
-  const int status = ::pclose(pipe);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
-}
+using test::Outcome;
+using test::run;
 
 std::string jello() {
   return JELLO_VIEWER;
@@ -170,8 +158,8 @@ TEST_F(Frames, WireframeAndShadedModesDiffer) {
 TEST(Recording, ThirtyFramesAreThirtyValidChangingJpegs) {
   test::TempDir dir;
   const auto out = dir.path() / "frames";
-  const Outcome r = run(headless(world("jello.w") + " --no-hud --frames 30 --record " +
-                                 out.string()));
+  const Outcome r =
+      run(headless(world("jello.w") + " --no-hud --frames 30 --record " + out.string()));
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("wrote 30 frames"), std::string::npos) << r.output;
   Image previous;
@@ -204,8 +192,10 @@ TEST(Recording, EveryIntegratorAndTheSphereSceneRecord) {
 
 TEST(Recording, ADivergingSimulationStopsWithExitCodeThree) {
   test::TempDir dir;
-  const Outcome r = run(headless(world("jello.w") + " --integrator euler --dt 0.01 --frames 100 "
-                                 "--record " + dir.path().string()));
+  const Outcome r = run(headless(world("jello.w") +
+                                 " --integrator euler --dt 0.01 --frames 100 "
+                                 "--record " +
+                                 dir.path().string()));
   EXPECT_EQ(r.code, 3) << r.output;
   EXPECT_NE(r.output.find("diverged"), std::string::npos) << r.output;
 }

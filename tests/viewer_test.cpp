@@ -153,9 +153,9 @@ TEST(PlaneInBox, IsTheBoxsCrossSectionWoundCounterClockwiseFromTheFreeSide) {
       EXPECT_GT(dot(cross(q - p, r - q), n), 0.0);
     }
   };
-  check({0.0, 0.0, 1.0, 0.0}, 4);   // the horizontal mid-plane: a square
-  check({1.0, 1.0, 1.0, 0.0}, 6);   // through the centre, normal along a diagonal: a hexagon
-  check({1.0, 1.0, 1.0, 5.0}, 3);   // near the corner (-2,-2,-2): a triangle
+  check({0.0, 0.0, 1.0, 0.0}, 4);  // the horizontal mid-plane: a square
+  check({1.0, 1.0, 1.0, 0.0}, 6);  // through the centre, normal along a diagonal: a hexagon
+  check({1.0, 1.0, 1.0, 5.0}, 3);  // near the corner (-2,-2,-2): a triangle
   EXPECT_TRUE(planeInBox({0.0, 0.0, 1.0, -5.0}).empty());
   const World jello = test::loadWorld("jello.w");
   ASSERT_TRUE(jello.plane.has_value());
@@ -288,8 +288,8 @@ TEST(Keys, TimeStepZoomCameraResetAndPullRadius) {
 
 TEST(Keys, TheTableNamesEveryKey) {
   const std::string table = keyTable();
-  for (const char* key : {"ESC", "space", "1-5", "+ -", "[ ]", "s h b", " v ", " p ", " r ",
-                          " f ", " g ", " e ", "z x", " i ", " . "}) {
+  for (const char* key : {"ESC", "space", "1-5", "+ -", "[ ]", "s h b", " v ", " p ", " r ", " f ",
+                          " g ", " e ", "z x", " i ", " . "}) {
     EXPECT_NE(("\n" + table).find(std::string(key).substr(key[0] == ' ')), std::string::npos)
         << key;
   }

@@ -46,7 +46,9 @@ std::vector<Vec3> planeInBox(const Plane& plane) {
   Vec3 e1 = cross(helper, n);
   e1 = e1 * (1.0 / norm(e1));
   const Vec3 e2 = cross(n, e1);
-  const auto angle = [&](const Vec3& p) { return std::atan2(dot(p - centre, e2), dot(p - centre, e1)); };
+  const auto angle = [&](const Vec3& p) {
+    return std::atan2(dot(p - centre, e2), dot(p - centre, e1));
+  };
   std::sort(unique.begin(), unique.end(),
             [&](const Vec3& p, const Vec3& q) { return angle(p) < angle(q); });
   return unique;

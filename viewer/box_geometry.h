@@ -15,8 +15,8 @@ namespace jello::viewer {
 std::vector<Vec3> planeInBox(const Plane& plane);
 
 struct Arrow {
-  Vec3 tail;  // m
-  Vec3 head;  // m
+  Vec3 tail;        // m
+  Vec3 head;        // m
   double strength;  // |F| / max |F| over the drawn nodes, in [0, 1]
 };
 // At most `perAxis`^3 field nodes, evenly subsampled; the longest arrow is `longest` metres.

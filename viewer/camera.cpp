@@ -47,9 +47,9 @@ void Camera::zoom(double metres) {
 Eigen::Matrix4d viewMatrix(const Camera& c) {
   const Vec3 e = c.eye(), f = c.forward(), s = c.right(), u = c.up();
   Eigen::Matrix4d m;
-  m << s.x, s.y, s.z, -dot(s, e),  //
-      u.x, u.y, u.z, -dot(u, e),   //
-      -f.x, -f.y, -f.z, dot(f, e), //
+  m << s.x, s.y, s.z, -dot(s, e),   //
+      u.x, u.y, u.z, -dot(u, e),    //
+      -f.x, -f.y, -f.z, dot(f, e),  //
       0.0, 0.0, 0.0, 1.0;
   return m;
 }
@@ -81,8 +81,7 @@ Ray pixelRay(const Camera& c, const Viewport& viewport, double x, double y) {
   return {c.eye(), normalized(d)};
 }
 
-Vec3 dragTarget(const Camera& c, const Viewport& viewport, double x, double y,
-                const Vec3& anchor) {
+Vec3 dragTarget(const Camera& c, const Viewport& viewport, double x, double y, const Vec3& anchor) {
   const Ray ray = pixelRay(c, viewport, x, y);
   const Vec3 f = c.forward();
   // The ray meets the plane dot(p - anchor, f) = 0 at the parameter below; rays through the

@@ -7,8 +7,8 @@
 namespace jello::viewer {
 
 std::span<const double> pullRadii() {
-  static constexpr std::array<double, 6> radii{
-      0.0, 0.15, 0.3, 0.6, 1.2, std::numeric_limits<double>::infinity()};
+  static constexpr std::array<double, 6> radii{0.0, 0.15, 0.3,
+                                               0.6, 1.2,  std::numeric_limits<double>::infinity()};
   return radii;
 }
 
@@ -42,8 +42,8 @@ Eigen::VectorXd pullForce(const Lattice& lattice, const State& state, int picked
   return f;
 }
 
-std::optional<int> pickPoint(const Camera& camera, const Viewport& viewport, const SurfaceMesh& mesh,
-                             const State& state, double x, double y) {
+std::optional<int> pickPoint(const Camera& camera, const Viewport& viewport,
+                             const SurfaceMesh& mesh, const State& state, double x, double y) {
   const Ray ray = pixelRay(camera, viewport, x, y);
   std::optional<int> best;
   double nearest = std::numeric_limits<double>::infinity();

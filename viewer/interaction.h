@@ -35,7 +35,7 @@ Eigen::VectorXd pullForce(const Lattice& lattice, const State& state, int picked
 // The surface point under pixel (x, y): the ray through the pixel hits the surface's nearest
 // triangle (Moller-Trumbore), and of its three corners the one closest to the hit is picked.
 // Nothing when the ray misses the cube.
-std::optional<int> pickPoint(const Camera& camera, const Viewport& viewport, const SurfaceMesh& mesh,
-                             const State& state, double x, double y);
+std::optional<int> pickPoint(const Camera& camera, const Viewport& viewport,
+                             const SurfaceMesh& mesh, const State& state, double x, double y);
 
 }  // namespace jello::viewer

@@ -94,8 +94,8 @@ void drawWireframeCube(const ViewerState& view, const Scene& scene) {
 // The six faces of the box as clip planes: a x + b y + c z + d >= 0 is kept.
 void clipToBox(bool on) {
   const double h = kBoxHalfSize;
-  const GLdouble planes[6][4] = {{1, 0, 0, h}, {-1, 0, 0, h}, {0, 1, 0, h},
-                                 {0, -1, 0, h}, {0, 0, 1, h}, {0, 0, -1, h}};
+  const GLdouble planes[6][4] = {{1, 0, 0, h},  {-1, 0, 0, h}, {0, 1, 0, h},
+                                 {0, -1, 0, h}, {0, 0, 1, h},  {0, 0, -1, h}};
   for (int i = 0; i < 6; ++i) {
     if (on) {
       glClipPlane(GL_CLIP_PLANE0 + i, planes[i]);
@@ -207,7 +207,8 @@ void drawFrame(const ViewerState& view, const Viewport& viewport, const Scene& s
   const Eigen::Matrix4d model = viewMatrix(view.camera);
   glLoadMatrixd(model.data());
   // Directional lights fixed in the world: a key light from above the camera's side, a fill.
-  const GLfloat keyDirection[] = {0.4f, 0.5f, 1.0f, 0.0f}, fillDirection[] = {-0.6f, -0.3f, 0.2f, 0.0f};
+  const GLfloat keyDirection[] = {0.4f, 0.5f, 1.0f, 0.0f},
+                fillDirection[] = {-0.6f, -0.3f, 0.2f, 0.0f};
   glLightfv(GL_LIGHT0, GL_POSITION, keyDirection);
   glLightfv(GL_LIGHT1, GL_POSITION, fillDirection);
 

@@ -20,8 +20,8 @@ namespace jello::viewer {
 inline constexpr float kBackground[3] = {0.10f, 0.11f, 0.14f};
 
 struct Scene {
-  const World* world = nullptr;             // plane, sphere
-  const State* state = nullptr;             // positions to draw (always a sane state)
+  const World* world = nullptr;  // plane, sphere
+  const State* state = nullptr;  // positions to draw (always a sane state)
   const SurfaceMesh* mesh = nullptr;
   const std::vector<Spring>* springs = nullptr;  // surface springs
   const std::vector<Arrow>* arrows = nullptr;    // field arrows

@@ -32,8 +32,7 @@ SurfaceMesh surfaceMesh(const Lattice& lattice) {
       const bool outwardPositive = side == n - 1;
       for (int a = 0; a + 1 < n; ++a) {
         for (int b = 0; b + 1 < n; ++b) {
-          const int p00 = at(a, b), p10 = at(a + 1, b), p11 = at(a + 1, b + 1),
-                    p01 = at(a, b + 1);
+          const int p00 = at(a, b), p10 = at(a + 1, b), p11 = at(a + 1, b + 1), p01 = at(a, b + 1);
           if (outwardPositive) {
             mesh.triangles.push_back({p00, p10, p11});
             mesh.triangles.push_back({p00, p11, p01});
@@ -65,9 +64,8 @@ std::vector<Vec3> vertexNormals(const SurfaceMesh& mesh, const State& state) {
 
 std::vector<Spring> surfaceSprings(const std::vector<Spring>& springs, const Lattice& lattice) {
   std::vector<Spring> out;
-  std::copy_if(springs.begin(), springs.end(), std::back_inserter(out), [&](const Spring& s) {
-    return onSurface(lattice, s.a) && onSurface(lattice, s.b);
-  });
+  std::copy_if(springs.begin(), springs.end(), std::back_inserter(out),
+               [&](const Spring& s) { return onSurface(lattice, s.a) && onSurface(lattice, s.b); });
   return out;
 }
 

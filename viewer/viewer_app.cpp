@@ -117,9 +117,11 @@ void Viewer::capture(const std::filesystem::path& path) {
 void Viewer::display() {
   const Simulation& sim = session_.simulation();
   overlay_.hud = hudLine();
-  Scene scene{&sim.world(), &sim.state(), &session_.mesh(), &session_.surfaceSprings(),
+  Scene scene{&sim.world(),       &sim.state(),
+              &session_.mesh(),   &session_.surfaceSprings(),
               &session_.arrows(), {}};
-  if (auto p = session_.pulling()) scene.pull = std::pair(sim.state().position(p->first), p->second);
+  if (auto p = session_.pulling())
+    scene.pull = std::pair(sim.state().position(p->first), p->second);
   drawFrame(view_, viewport_, scene, overlay_);
 
   if (screenshotPending_) {
@@ -199,8 +201,11 @@ void Viewer::key(unsigned char key) {
   const KeyResult result = handleKey(view_, key);
   Simulation& sim = session_.simulation();
   switch (result.command) {
-    case Command::Quit: return leave(0);
-    case Command::Screenshot: screenshotPending_ = true; break;
+    case Command::Quit:
+      return leave(0);
+    case Command::Screenshot:
+      screenshotPending_ = true;
+      break;
     case Command::Reload:
       if (std::optional<std::string> error = session_.reload()) {
         notify("reload failed, scene kept: " + *error, true);
@@ -218,11 +223,14 @@ void Viewer::key(unsigned char key) {
         notify("integrator " + std::string(integratorName(*result.integrator)), false);
       }
       break;
-    case Command::TimeStep: session_.scaleTimeStep(view_.dtScale); break;
+    case Command::TimeStep:
+      session_.scaleTimeStep(view_.dtScale);
+      break;
     case Command::StepOnce:
       if (view_.paused) advance();
       break;
-    case Command::None: break;
+    case Command::None:
+      break;
   }
   glutPostRedisplay();
 }

@@ -16,8 +16,8 @@ namespace jello::viewer {
 inline constexpr int kMaxRecordedFrames = 300;  // the course's rule: 15 frames per second
 
 struct ViewerOptions {
-  SceneSource source;                        // the world file and its overrides
-  std::filesystem::path recordDir;           // non-empty: record `frames` frames and exit
+  SceneSource source;               // the world file and its overrides
+  std::filesystem::path recordDir;  // non-empty: record `frames` frames and exit
   int frames = 0;
   Viewport size;
   bool realTime = false;   // advance by wall-clock time instead of n*dt per frame

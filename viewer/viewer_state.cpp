@@ -14,24 +14,51 @@ KeyResult handleKey(ViewerState& s, unsigned char key) {
     return {Command::SwitchIntegrator, integrators[key - '1']};
   }
   switch (key) {
-    case 27: return {Command::Quit, {}};
-    case ' ': return {Command::Screenshot, {}};
-    case 'r': return {Command::Reload, {}};
-    case 'e': s.camera = Camera{}; break;
-    case 'z': s.camera.zoom(-0.2); break;
-    case 'x': s.camera.zoom(0.2); break;
+    case 27:
+      return {Command::Quit, {}};
+    case ' ':
+      return {Command::Screenshot, {}};
+    case 'r':
+      return {Command::Reload, {}};
+    case 'e':
+      s.camera = Camera{};
+      break;
+    case 'z':
+      s.camera.zoom(-0.2);
+      break;
+    case 'x':
+      s.camera.zoom(0.2);
+      break;
     case 'v':
       s.mode = s.mode == DisplayMode::Shaded ? DisplayMode::Wireframe : DisplayMode::Shaded;
       break;
-    case 's': s.structural = !s.structural; break;
-    case 'h': s.shear = !s.shear; break;
-    case 'b': s.bend = !s.bend; break;
-    case 'p': s.paused = !s.paused; break;
-    case 'f': s.showField = !s.showField; break;
-    case 'i': s.showHud = !s.showHud; break;
-    case 'g': s.pullMode = !s.pullMode; break;
-    case '[': s.pullRadius = std::max(0, s.pullRadius - 1); break;
-    case ']': s.pullRadius = std::min(int(pullRadii().size()) - 1, s.pullRadius + 1); break;
+    case 's':
+      s.structural = !s.structural;
+      break;
+    case 'h':
+      s.shear = !s.shear;
+      break;
+    case 'b':
+      s.bend = !s.bend;
+      break;
+    case 'p':
+      s.paused = !s.paused;
+      break;
+    case 'f':
+      s.showField = !s.showField;
+      break;
+    case 'i':
+      s.showHud = !s.showHud;
+      break;
+    case 'g':
+      s.pullMode = !s.pullMode;
+      break;
+    case '[':
+      s.pullRadius = std::max(0, s.pullRadius - 1);
+      break;
+    case ']':
+      s.pullRadius = std::min(int(pullRadii().size()) - 1, s.pullRadius + 1);
+      break;
     case '+':
     case '=':
       s.dtScale *= 2.0;
@@ -39,8 +66,10 @@ KeyResult handleKey(ViewerState& s, unsigned char key) {
     case '-':
       s.dtScale *= 0.5;
       return {Command::TimeStep, {}};
-    case '.': return {Command::StepOnce, {}};
-    default: break;
+    case '.':
+      return {Command::StepOnce, {}};
+    default:
+      break;
   }
   return {};
 }
