@@ -295,6 +295,18 @@ TEST(Keys, TheTableNamesEveryKey) {
   }
 }
 
+TEST(HeadsUpText, WrapsAtNewlinesAndSpacesWithinTheWidth) {
+  EXPECT_EQ(wrapText("rk4  dt 0.001\n[paused]", 40),
+            (std::vector<std::string>{"rk4  dt 0.001", "[paused]"}));
+  EXPECT_EQ(wrapText("diverged at t = 1.5 s, step 30", 12),
+            (std::vector<std::string>{"diverged at", "t = 1.5 s,", "step 30"}));
+  EXPECT_EQ(wrapText("abcdefghij", 4), (std::vector<std::string>{"abcd", "efgh", "ij"}));
+  for (const std::string& line : wrapText(std::string(300, 'x') + " y z", 77)) {
+    EXPECT_LE(line.size(), 77u);
+  }
+  EXPECT_TRUE(wrapText("", 10).empty());
+}
+
 TEST(FramePacing, StepsCoverTheFramesSimulatedTime) {
   EXPECT_EQ(stepsPerFrame(0.0005, 0.0005), 1);
   EXPECT_EQ(stepsPerFrame(0.0005, 0.00025), 2);

@@ -1,5 +1,7 @@
 #include "renderer.h"
 
+#include <algorithm>
+
 // glWindowPos (GL 1.4) is declared only with the extension prototypes.
 #define GL_GLEXT_PROTOTYPES
 #include <GL/freeglut.h>
@@ -162,9 +164,14 @@ void drawText(int x, int y, const std::string& text) {
 
 void drawOverlay(const Viewport& viewport, const ViewerState& view, const Overlay& overlay) {
   glDisable(GL_DEPTH_TEST);
+  const std::size_t width = static_cast<std::size_t>(std::max(8, viewport.width / 8 - 2));
   if (view.showHud && !overlay.hud.empty()) {
     glColor3f(0.92f, 0.92f, 0.92f);
-    drawText(8, viewport.height - 18, overlay.hud);
+    int y = viewport.height - 18;
+    for (const std::string& line : wrapText(overlay.hud, width)) {
+      drawText(8, y, line);
+      y -= 16;
+    }
   }
   if (!overlay.message.empty()) {
     if (overlay.alarm) {
@@ -172,7 +179,12 @@ void drawOverlay(const Viewport& viewport, const ViewerState& view, const Overla
     } else {
       glColor3f(0.6f, 1.0f, 0.6f);
     }
-    drawText(8, 10, overlay.message);
+    const std::vector<std::string> lines = wrapText(overlay.message, width);
+    int y = 10 + 16 * static_cast<int>(lines.size() - 1);
+    for (const std::string& line : lines) {
+      drawText(8, y, line);
+      y -= 16;
+    }
   }
   glEnable(GL_DEPTH_TEST);
 }

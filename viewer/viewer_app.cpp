@@ -88,10 +88,11 @@ std::string Viewer::hudLine() const {
      << format("%.3f", sim.state().t) << " s  " << format("%.0f", fps_) << " fps  "
      << format("%.3g", realTimeFactor_) << "x real time  E "
      << format("%.4g", sim.model().energy(sim.state()).total()) << " J";
-  if (view_.paused) os << "  [paused]";
+  if (view_.paused || view_.pullMode || drag_ == Drag::Pull) os << '\n';
+  if (view_.paused) os << "[paused]  ";
   if (view_.pullMode || drag_ == Drag::Pull) {
     const double r = pullRadius();
-    os << "  pull radius " << (std::isinf(r) ? std::string("whole cube") : format("%.2g m", r));
+    os << "pull radius " << (std::isinf(r) ? std::string("whole cube") : format("%.2g m", r));
   }
   return os.str();
 }
@@ -102,10 +103,11 @@ void Viewer::advance() {
   if (options_.realTime) frameTime = std::min(0.1, seconds(now - lastAdvance_));
   lastAdvance_ = now;
   const double t0 = session_.simulation().state().t;
+  const bool divergedBefore = session_.simulation().divergence().has_value();
   if (std::optional<std::string> failure = session_.advance(frameTime)) {
     view_.paused = true;
     notify(*failure + " - press r to reload", true);
-    std::cerr << "jello: " << *failure << '\n';
+    if (!divergedBefore) std::cerr << "jello: " << *failure << '\n';
   }
   windowSimTime_ += session_.simulation().state().t - t0;
 }

@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <sstream>
+#include <vector>
 
 #include "interaction.h"
 
@@ -104,6 +105,22 @@ std::string keyTable() {
     os << "  " << k.keys << std::string(18 - std::string(k.keys).size(), ' ') << k.action << '\n';
   }
   return os.str();
+}
+
+std::vector<std::string> wrapText(const std::string& text, std::size_t width) {
+  std::vector<std::string> lines;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    if (end - start > width) {
+      const std::size_t space = text.rfind(' ', start + width);
+      end = space != std::string::npos && space > start ? space : start + width;
+    }
+    lines.push_back(text.substr(start, end - start));
+    start = end < text.size() && (text[end] == '\n' || text[end] == ' ') ? end + 1 : end;
+  }
+  return lines;
 }
 
 int stepsPerFrame(double frameTime, double dt) {

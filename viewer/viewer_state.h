@@ -5,6 +5,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "camera.h"
 #include "integrator_name.h"
@@ -52,6 +53,10 @@ struct KeyBinding {
 // The key table, one source for --help, the README and the on-screen help.
 std::span<const KeyBinding> keyBindings();
 std::string keyTable();  // "  keys  action" lines
+
+// The heads-up text as lines of at most `width` characters, broken at '\n' and, when too
+// long, at the last space that fits (or hard, when there is none).
+std::vector<std::string> wrapText(const std::string& text, std::size_t width);
 
 // Simulated seconds to advance per displayed frame, split into whole steps of at most dt:
 // the frame time is the world's n*dt0 (fixed when +/- change dt), at least one step.
