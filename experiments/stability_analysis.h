@@ -36,16 +36,17 @@ double predictedThreshold(IntegratorKind kind, double wMax, double dampingRatio)
 // The standard scenes, spring damping c = r k:
 //   "free": the cube at rest with its far corner pulled out by one spacing, in the middle of the
 //           box, touching nothing (the walls are never reached);
-//   "wall": the same cube under gravity resting on the floor, its bottom layer pressed in by
-//           the static load of its column, with contact springs contactRatio times stiffer
-//           than the lattice's (kCollision = contactRatio k, dCollision = r kCollision): the
-//           contact mode, not the lattice, sets w_max, and it stays in contact.
+//   "wall": the cube pressed onto the floor by a uniform load that sinks its bottom layer 1% of
+//           a spacing into it, contact springs contactRatio times stiffer than the lattice's
+//           (kCollision = contactRatio k, dCollision = r kCollision); settled to its loaded
+//           equilibrium, then every point moved by up to 10^-4 of a spacing. The contact mode
+//           sets w_max, and the cube stays in contact.
 World stabilityScene(std::string_view scene, double k, double dampingRatio,
                      double contactRatio = 20.0);
 
 // "Blew up": within `time` simulated seconds, a step produced a non-finite or far state (the
-// simulation's divergence check, bound 100 m) or the total energy (kinetic + spring + contact)
-// rose above energyFactor times its start.
+// simulation's divergence check, bound 100 m) or the total energy (kinetic + spring + contact,
+// minus the work the force field has done) rose above energyFactor times its start.
 struct BlowUpRule {
   double time = 0.2;  // s
   double energyFactor = 10.0;
