@@ -7,7 +7,7 @@ set datafile separator ','
 set logscale xy
 set format xy '10^{%L}'
 set grid
-set key outside right top
+set key below maxrows 3
 set xlabel 'spring stiffness k (N/m)'
 sel(scene, integ, src) = sprintf("< awk -F, '$1==\"%s\" && $2==\"%s\" && $7==\"%s\"' %s", scene, integ, src, csv)
 m = 1.0/512
@@ -16,8 +16,8 @@ colors = "#d62728 #2ca02c #1f77b4 #9467bd #ff7f0e"
 
 do for [scene in "free wall"] {
   do for [fmt in "pngcairo svg"] {
-    if (fmt eq "pngcairo") { set terminal pngcairo size 900,560 font ",10"; set output dir.'/stability_'.scene.'.png' } \
-    else { set terminal svg size 900,560 font ",10"; set output dir.'/stability_'.scene.'.svg' }
+    if (fmt eq "pngcairo") { set terminal pngcairo size 900,620 font ",10"; set output dir.'/stability_'.scene.'.png' } \
+    else { set terminal svg size 900,620 font ",10"; set output dir.'/stability_'.scene.'.svg' }
     set title 'Largest stable time step, '.scene.' scene (points measured, lines predicted)'
     set ylabel 'dt (s)'
     set yrange [1e-6:0.1]
@@ -29,8 +29,8 @@ do for [scene in "free wall"] {
     set output
   }
   do for [fmt in "pngcairo svg"] {
-    if (fmt eq "pngcairo") { set terminal pngcairo size 900,560 font ",10"; set output dir.'/courant_'.scene.'.png' } \
-    else { set terminal svg size 900,560 font ",10"; set output dir.'/courant_'.scene.'.svg' }
+    if (fmt eq "pngcairo") { set terminal pngcairo size 900,620 font ",10"; set output dir.'/courant_'.scene.'.png' } \
+    else { set terminal svg size 900,620 font ",10"; set output dir.'/courant_'.scene.'.svg' }
     set title 'Thresholds in Courant numbers h w_{max}, '.scene.' scene'
     set ylabel 'h w_{max}'
     set yrange [0.005:10]
