@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs the three experiments in full and draws their charts into experiments/results/ (CSV,
-# JSON sidecars, PNG and SVG). About 25 minutes on 2 cores. `scripts/run-experiments.sh quick`
+# JSON sidecars, PNG and SVG). About 5 minutes on 2 cores. `scripts/run-experiments.sh quick`
 # runs the --quick grids instead (under a minute), into build/experiments-quick/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -9,16 +9,20 @@ scripts/build.sh release >/dev/null
 bin=build/release/experiments
 out=experiments/results
 args=()
+stability_scenes='free wall'
+precision_scenes='soft stiff'
 if [ "${1:-}" = quick ]; then
   out=build/experiments-quick
   args=(--quick)
+  stability_scenes=free
+  precision_scenes=soft
 fi
 mkdir -p "$out"
 "$bin/jello-stability" "${args[@]}" --out-dir "$out"
 "$bin/jello-work-precision" "${args[@]}" --out-dir "$out"
 # One point at a time: a neighbour's memory traffic would bend the timings.
 "$bin/jello-scaling" "${args[@]}" --jobs 1 --out-dir "$out"
-for plot in stability work_precision scaling; do
-  gnuplot -e "dir='$out'" "experiments/plots/$plot.gp"
-done
+gnuplot -e "dir='$out'; scenes='$stability_scenes'" experiments/plots/stability.gp
+gnuplot -e "dir='$out'; scenes='$precision_scenes'" experiments/plots/work_precision.gp
+gnuplot -e "dir='$out'" experiments/plots/scaling.gp
 echo "run-experiments: results and charts in $out/"

@@ -2,6 +2,7 @@
 # lines), and the same thresholds in Courant numbers h*w_max.
 # gnuplot -e "dir='experiments/results'" experiments/plots/stability.gp
 if (!exists("dir")) dir = 'experiments/results'
+if (!exists("scenes")) scenes = 'free wall'  # the scenes the CSV holds (--quick: free)
 csv = dir.'/stability.csv'
 set datafile separator ','
 set logscale xy
@@ -14,7 +15,7 @@ m = 1.0/512
 integrators = "euler symplectic rk4 implicit cvode"
 colors = "#d62728 #2ca02c #1f77b4 #9467bd #ff7f0e"
 
-do for [scene in "free wall"] {
+do for [scene in scenes] {
   do for [fmt in "pngcairo svg"] {
     if (fmt eq "pngcairo") { set terminal pngcairo size 900,620 font ",10"; set output dir.'/stability_'.scene.'.png' } \
     else { set terminal svg size 900,620 font ",10"; set output dir.'/stability_'.scene.'.svg' }

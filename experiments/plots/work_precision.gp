@@ -2,6 +2,7 @@
 # backward Euler's artificial damping from work_precision_damping.csv.
 # gnuplot -e "dir='experiments/results'" experiments/plots/work_precision.gp
 if (!exists("dir")) dir = 'experiments/results'
+if (!exists("scenes")) scenes = 'soft stiff'  # the scenes the CSV holds (--quick: soft)
 csv = dir.'/work_precision.csv'
 set datafile separator ','
 set logscale xy
@@ -11,7 +12,7 @@ sel(scene, integ, order) = sprintf("< awk -F, '$1==\"%s\" && $2==\"%s\" && $3==%
 integrators = "euler symplectic rk4 implicit"
 colors = "#d62728 #2ca02c #1f77b4 #9467bd"
 
-do for [scene in "soft stiff"] {
+do for [scene in scenes] {
   do for [q in "position energy"] {
     col = (q eq "position") ? 8 : 9
     do for [fmt in "pngcairo svg"] {
