@@ -116,6 +116,21 @@ void writeSidecar(const std::filesystem::path& path, const nlohmann::json& sidec
   writeFileAtomically(path, sidecar.dump(2) + "\n");
 }
 
+bool writeResults(const std::string& program, const std::filesystem::path& dir,
+                  const std::string& name, const CsvTable& table, const nlohmann::json& sidecar,
+                  const std::vector<std::pair<std::string, const CsvTable*>>& extra) {
+  try {
+    std::filesystem::create_directories(dir);
+    table.write(dir / (name + ".csv"));
+    for (const auto& [suffix, other] : extra) other->write(dir / (name + "_" + suffix + ".csv"));
+    writeSidecar(dir / (name + ".json"), sidecar);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: error: %s\n", program.c_str(), e.what());
+    return false;
+  }
+  return true;
+}
+
 void parallelFor(int count, int jobs, const std::string& label, bool progress,
                  const std::function<void(int)>& task) {
   std::atomic<int> next{0}, done{0};

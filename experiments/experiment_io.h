@@ -35,6 +35,12 @@ class CsvTable {
 nlohmann::json runContext(int argc, char** argv);
 void writeSidecar(const std::filesystem::path& path, const nlohmann::json& sidecar);
 
+// Writes `table` to DIR/NAME.csv, each of `extra` to DIR/NAME_<suffix>.csv and the sidecar
+// to DIR/NAME.json, creating DIR. On failure prints "<program>: error: ..." and returns false.
+bool writeResults(const std::string& program, const std::filesystem::path& dir,
+                  const std::string& name, const CsvTable& table, const nlohmann::json& sidecar,
+                  const std::vector<std::pair<std::string, const CsvTable*>>& extra = {});
+
 // Which BLAS this process loaded (CHOLMOD's supernodal factorization depends on it).
 std::string loadedBlas();
 

@@ -166,14 +166,7 @@ int main(int argc, char** argv) {
       {"quick", quick}};
   sidecar["wall_time_s"] = std::chrono::duration<double>(Clock::now() - started).count();
   const std::filesystem::path dir = outDir;
-  try {
-    std::filesystem::create_directories(dir);
-    table.write(dir / (name + ".csv"));
-    writeSidecar(dir / (name + ".json"), sidecar);
-  } catch (const std::exception& e) {
-    std::cerr << "jello-scaling: error: " << e.what() << '\n';
-    return 1;
-  }
+  if (!writeResults("jello-scaling", dir, name, table, sidecar)) return 1;
   if (!quiet) {
     std::printf("wrote %zu rows to %s (%.1f s)\n", table.rows(), (dir / (name + ".csv")).c_str(),
                 sidecar["wall_time_s"].get<double>());

@@ -186,14 +186,7 @@ int main(int argc, char** argv) {
   sidecar["wall_time_s"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   const std::filesystem::path dir = opt.outDir;
-  try {
-    std::filesystem::create_directories(dir);
-    table.write(dir / (opt.name + ".csv"));
-    writeSidecar(dir / (opt.name + ".json"), sidecar);
-  } catch (const std::exception& e) {
-    std::cerr << "jello-stability: error: " << e.what() << '\n';
-    return 1;
-  }
+  if (!writeResults("jello-stability", dir, opt.name, table, sidecar)) return 1;
   if (!opt.quiet) {
     std::printf("wrote %zu rows to %s (%.1f s)\n", table.rows(),
                 (dir / (opt.name + ".csv")).c_str(), sidecar["wall_time_s"].get<double>());

@@ -251,13 +251,7 @@ int main(int argc, char** argv) {
                            {"energy_relative_error", "|E - E_ref| / |E_ref| at time_s"}};
   sidecar["wall_time_s"] = std::chrono::duration<double>(Clock::now() - started).count();
   const std::filesystem::path dir = outDir;
-  try {
-    std::filesystem::create_directories(dir);
-    table.write(dir / (name + ".csv"));
-    damping.write(dir / (name + "_damping.csv"));
-    writeSidecar(dir / (name + ".json"), sidecar);
-  } catch (const std::exception& e) {
-    std::cerr << "jello-work-precision: error: " << e.what() << '\n';
+  if (!writeResults("jello-work-precision", dir, name, table, sidecar, {{"damping", &damping}})) {
     return 1;
   }
   if (!quiet) {
