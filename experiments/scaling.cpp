@@ -111,10 +111,7 @@ int main(int argc, char** argv) {
   try {
     parallelFor(int(tasks.size()), jobs, "points", !quiet, [&](int i) {
       const Task& t = tasks[static_cast<std::size_t>(i)];
-      SceneSpec spec = stiffCube(k);
-      spec.pose = PosePreset::Stretched;
-      spec.stretch = 1.05;
-      spec.spin = 2.0;
+      SceneSpec spec = vibratingStiffCube(k);
       spec.cubeResolution = t.n;
       World w = buildWorld(spec);
       const double wMax = maxAngularFrequency(Model(w), initialState(w));

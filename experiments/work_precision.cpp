@@ -24,14 +24,10 @@ using namespace jello;
 using namespace jello::experiments;
 using Clock = std::chrono::steady_clock;
 
-// The stiff cube for accuracy studies: stretched 5% along x and spinning at 2 rad/s, so its
-// energy sits in smooth, mostly low modes (the skewed corner of stiffCube strains one spring
-// 100% and is violently nonlinear at this stiffness).
+// vibratingStiffCube with the given damping and spin, centred in the box.
 World stiffScene(double k, double damping, double spin = 2.0) {
-  SceneSpec spec = stiffCube(k);
+  SceneSpec spec = vibratingStiffCube(k);
   spec.dElastic = damping;
-  spec.pose = PosePreset::Stretched;
-  spec.stretch = 1.05;
   spec.spin = spin;
   World w = buildWorld(spec);
   for (Vec3& p : w.positions) p += Vec3{-0.5, -0.5, -0.5};

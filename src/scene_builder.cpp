@@ -59,6 +59,14 @@ SceneSpec stiffCube(double k) {
   return spec;
 }
 
+SceneSpec vibratingStiffCube(double k) {
+  SceneSpec spec = stiffCube(k);
+  spec.pose = PosePreset::Stretched;
+  spec.stretch = 1.05;
+  spec.spin = 2.0;
+  return spec;
+}
+
 double defaultFieldStrength(FieldPreset preset, double mass) {
   switch (preset) {
     case FieldPreset::None:
