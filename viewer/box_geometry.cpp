@@ -7,11 +7,10 @@
 
 namespace jello::viewer {
 
-std::vector<Vec3> planeInBox(const Plane& plane) {
-  const Vec3 normal{plane.a, plane.b, plane.c};
+std::array<std::pair<Vec3, Vec3>, 12> boxEdges() {
   const double h = kBoxHalfSize;
-  const auto side = [&](const Vec3& p) { return dot(normal, p) + plane.d; };
-  std::vector<Vec3> corners;
+  std::array<std::pair<Vec3, Vec3>, 12> edges;
+  std::size_t e = 0;
   // Edges along each axis: the other two coordinates at +-h.
   for (int axis = 0; axis < 3; ++axis) {
     for (double u : {-h, h}) {
@@ -21,13 +20,22 @@ std::vector<Vec3> planeInBox(const Plane& plane) {
         hi[axis] = h;
         lo[(axis + 1) % 3] = hi[(axis + 1) % 3] = u;
         lo[(axis + 2) % 3] = hi[(axis + 2) % 3] = w;
-        const Vec3 a{lo[0], lo[1], lo[2]}, b{hi[0], hi[1], hi[2]};
-        const double sa = side(a), sb = side(b);
-        if ((sa < 0.0) == (sb < 0.0) && sa != 0.0) continue;
-        const double t = sa == sb ? 0.0 : sa / (sa - sb);
-        corners.push_back(a + (b - a) * t);
+        edges[e++] = {Vec3{lo[0], lo[1], lo[2]}, Vec3{hi[0], hi[1], hi[2]}};
       }
     }
+  }
+  return edges;
+}
+
+std::vector<Vec3> planeInBox(const Plane& plane) {
+  const Vec3 normal{plane.a, plane.b, plane.c};
+  const auto side = [&](const Vec3& p) { return dot(normal, p) + plane.d; };
+  std::vector<Vec3> corners;
+  for (const auto& [a, b] : boxEdges()) {
+    const double sa = side(a), sb = side(b);
+    if ((sa < 0.0) == (sb < 0.0) && sa != 0.0) continue;
+    const double t = sa == sb ? 0.0 : sa / (sa - sb);
+    corners.push_back(a + (b - a) * t);
   }
   // Corners met at a box vertex appear up to three times.
   std::vector<Vec3> unique;

@@ -4,11 +4,16 @@
 //   by angle around their centroid in the plane (a convex polygon of 3 to 6 corners).
 #pragma once
 
+#include <array>
+#include <utility>
 #include <vector>
 
 #include "world.h"
 
 namespace jello::viewer {
+
+// The box's 12 edges, as (start, end) pairs.
+std::array<std::pair<Vec3, Vec3>, 12> boxEdges();
 
 // The plane's part inside the box, corners in counter-clockwise order seen from the free side
 // (where a x + b y + c z + d > 0); empty when the plane misses the box.

@@ -20,18 +20,9 @@ void drawBox() {
   const double h = kBoxHalfSize;
   glColor3f(0.75f, 0.75f, 0.8f);
   glBegin(GL_LINES);
-  for (int axis = 0; axis < 3; ++axis) {
-    for (double u : {-h, h}) {
-      for (double w : {-h, h}) {
-        double a[3], b[3];
-        a[axis] = -h;
-        b[axis] = h;
-        a[(axis + 1) % 3] = b[(axis + 1) % 3] = u;
-        a[(axis + 2) % 3] = b[(axis + 2) % 3] = w;
-        glVertex3dv(a);
-        glVertex3dv(b);
-      }
-    }
+  for (const auto& [a, b] : boxEdges()) {
+    vertex(a);
+    vertex(b);
   }
   // A grid on the floor, for depth.
   glColor3f(0.3f, 0.3f, 0.36f);
