@@ -2,7 +2,6 @@
 // "blew up", and --quick runs of each program whose CSV must hold the physics the README
 // states (thresholds near their predictions, flat Courant numbers, convergence orders).
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cmath>
 #include <fstream>
@@ -132,9 +131,9 @@ Table readCsv(const std::filesystem::path& path) {
   return rows;
 }
 
+// A program's exit code, run without its progress line.
 int run(const std::string& command) {
-  const int status = std::system((command + " --quiet > /dev/null 2>&1").c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return test::run(command + " --quiet").code;
 }
 
 double number(const std::map<std::string, std::string>& row, const std::string& column) {
