@@ -71,7 +71,6 @@ class Viewer {
 
   enum class Drag { None, Rotate, Push, Pull } drag_ = Drag::None;
   int lastX_ = 0, lastY_ = 0, pressX_ = 0, pressY_ = 0;
-  int picked_ = -1;
   Vec3 anchor_;  // the picked point where the pull began: the drag plane goes through it
 
   // Rates over the last half second.
@@ -254,9 +253,8 @@ void Viewer::mouse(int button, int state, int x, int y) {
       drag_ = Drag::Push;
     } else if (auto p = pickPoint(view_.camera, viewport_, session_.mesh(), s, x, y)) {
       drag_ = Drag::Pull;
-      picked_ = *p;
-      anchor_ = s.position(picked_);
-      session_.pull(picked_, anchor_, pullRadius());
+      anchor_ = s.position(*p);
+      session_.pull(*p, anchor_, pullRadius());
     }
   }
 }
@@ -267,8 +265,8 @@ void Viewer::motion(int x, int y) {
   lastY_ = y;
   if (drag_ == Drag::Push) {
     session_.push(screenDragToWorld(view_.camera, x - pressX_, y - pressY_) * kPushPerPixel);
-  } else if (drag_ == Drag::Pull) {
-    session_.pull(picked_, dragTarget(view_.camera, viewport_, x, y, anchor_), pullRadius());
+  } else if (auto pulled = session_.pulling()) {  // the session keeps the picked point
+    session_.pull(pulled->first, dragTarget(view_.camera, viewport_, x, y, anchor_), pullRadius());
   }
 }
 
