@@ -8,5 +8,5 @@ frames=${2:-1200}
 scripts/build.sh release >/dev/null
 for mode in "" --wireframe; do
   xvfb-run -a -s "-screen 0 1024x768x24" \
-    build/release/viewer/jello "$world" --integrator rk4 --benchmark "$frames" $mode
+    build/release/bin/jello "$world" --integrator rk4 --benchmark "$frames" $mode
 done

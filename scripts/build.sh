@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# Configures (once) and builds one CMake preset: release (default), debug or asan.
+# Configures (once, or again when JELLO_WERROR is set) and builds one CMake preset: release
+# (default), debug, asan or fuzz. Programs land in build/<preset>/bin.
+# JELLO_WERROR=ON (as CI sets it) turns compiler warnings into errors.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset=${1:-release}
-if [ ! -f "build/$preset/CMakeCache.txt" ]; then
-  cmake --preset "$preset" >/dev/null
+if [ ! -f "build/$preset/CMakeCache.txt" ] || [ -n "${JELLO_WERROR:-}" ]; then
+  cmake --preset "$preset" ${JELLO_WERROR:+"-DJELLO_WERROR=$JELLO_WERROR"} >/dev/null
 fi
 cmake --build --preset "$preset" -j"$(nproc)"

@@ -9,7 +9,7 @@ packages=(
   freeglut3-dev libgl1-mesa-dev libglu1-mesa-dev xvfb xauth libstb-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libspectra-dev libcli11-dev nlohmann-json3-dev gnuplot-nox
-  clang-14 libclang-rt-14-dev
+  clang-14 libclang-rt-14-dev clang-format-14
 )
 
 missing=()

@@ -3,7 +3,7 @@
 # worlds there are copies and are never regenerated). Run after scripts/build.sh.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-create=build/release/experiments/jello-create-world
+create=build/release/bin/jello-create-world
 
 # Stiff free cubes for the stability studies: no plane, no field, undamped, far corner pulled.
 $create -o worlds/stiff-k1e4.w --k-elastic 1e4 --d-elastic 0 --no-plane --field-resolution 0 \

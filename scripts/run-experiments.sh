@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/build.sh release >/dev/null
-bin=build/release/experiments
+bin=build/release/bin
 out=experiments/results
 args=()
 stability_scenes='free wall'

@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/build.sh release
-viewer=build/release/viewer/jello
+viewer=build/release/bin/jello
 if [ -n "${DISPLAY:-}" ]; then
   exec "$viewer" worlds/jello.w "$@"
 fi

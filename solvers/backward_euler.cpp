@@ -1,4 +1,4 @@
-#include "backward_euler.h"
+#include "solvers/backward_euler.h"
 
 #include <algorithm>
 #include <chrono>

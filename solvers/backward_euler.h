@@ -15,15 +15,16 @@
 
 #include <memory>
 
-#include "integrator.h"
-#include "jacobian.h"
-#include "linear_solver.h"
+#include "solvers/integrator.h"
+#include "solvers/jacobian.h"
+#include "solvers/linear_solver.h"
 
 namespace jello {
 
 class BackwardEuler final : public Integrator {
  public:
   explicit BackwardEuler(ImplicitOptions options = {});
+  explicit BackwardEuler(const SolverOptions& options) : BackwardEuler(options.implicit) {}
 
   IntegratorKind kind() const override { return IntegratorKind::Implicit; }
   StepResult step(const Model& model, State& state, double h) override;

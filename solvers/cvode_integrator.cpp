@@ -1,4 +1,4 @@
-#include "cvode_integrator.h"
+#include "solvers/cvode_integrator.h"
 
 #include <cvode/cvode_ls.h>
 #include <nvector/nvector_serial.h>
@@ -76,7 +76,8 @@ CvodeIntegrator::~CvodeIntegrator() {
 }
 
 bool CvodeIntegrator::continues(const Model& model, const State& s) const {
-  if (restartPending_ || !cvode_ || model_ != &model || n3_ != 3 * model.numPoints() || s.t != t_) return false;
+  if (restartPending_ || !cvode_ || model_ != &model || n3_ != 3 * model.numPoints() || s.t != t_)
+    return false;
   const double* y = N_VGetArrayPointer(y_.get());
   const std::size_t bytes = static_cast<std::size_t>(n3_) * sizeof(double);
   return std::memcmp(y, s.x.data(), bytes) == 0 && std::memcmp(y + n3_, s.v.data(), bytes) == 0;

@@ -1,7 +1,7 @@
 // SUNDIALS CVODE (6.4), variable-order BDF with Newton iterations, on y = (x, v):
 //   y' = (v, M^-1 f(x, v)),   Newton matrix I - g J,   J = [[0, I], [M^-1 K, M^-1 D]].
 // Its linear systems (I - g J)(a, b) = (r1, r2) are solved through the reduced, symmetric
-// 3n system (physics.md)
+// 3n system (src/PHYSICS.md)
 //   (M - g D - g^2 K) b = M r2 + g K r1,   a = r1 + g b,
 // with the same Jacobian assembly and CHOLMOD (or CG) machinery as backward Euler, inside a
 // custom linear solver of DIRECT type, so CVODE keeps its own heuristics for when to refresh
@@ -11,16 +11,17 @@
 
 #include <memory>
 
-#include "integrator.h"
-#include "jacobian.h"
-#include "linear_solver.h"
-#include "sundials_handles.h"
+#include "solvers/integrator.h"
+#include "solvers/jacobian.h"
+#include "solvers/linear_solver.h"
+#include "solvers/sundials_handles.h"
 
 namespace jello {
 
 class CvodeIntegrator final : public Integrator {
  public:
   explicit CvodeIntegrator(CvodeOptions options = {});
+  explicit CvodeIntegrator(const SolverOptions& options) : CvodeIntegrator(options.cvode) {}
   ~CvodeIntegrator() override;
 
   IntegratorKind kind() const override { return IntegratorKind::Cvode; }

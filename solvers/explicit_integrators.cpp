@@ -1,4 +1,4 @@
-#include "explicit_integrators.h"
+#include "solvers/explicit_integrators.h"
 
 namespace jello {
 

@@ -1,4 +1,4 @@
-// The explicit integrators, each exactly as physics.md states it (a = M^-1 f(x, v)):
+// The explicit integrators, each exactly as src/PHYSICS.md states it (a = M^-1 f(x, v)):
 //   euler       a from the old state; x += h v_old; v += h a              (order 1)
 //   symplectic  a from the old state; v += h a;     x += h v_new          (order 1, symplectic)
 //   rk4         classical four stages on (x, v)                           (order 4)
@@ -7,12 +7,15 @@
 
 #include <Eigen/Core>
 
-#include "integrator.h"
+#include "solvers/integrator.h"
 
 namespace jello {
 
 class ExplicitEuler final : public Integrator {
  public:
+  ExplicitEuler() = default;
+  explicit ExplicitEuler(const SolverOptions&) {
+  }  // nothing to set: the factory's uniform signature
   IntegratorKind kind() const override { return IntegratorKind::Euler; }
   StepResult step(const Model& model, State& state, double h) override;
 
@@ -22,6 +25,9 @@ class ExplicitEuler final : public Integrator {
 
 class SymplecticEuler final : public Integrator {
  public:
+  SymplecticEuler() = default;
+  explicit SymplecticEuler(const SolverOptions&) {
+  }  // nothing to set: the factory's uniform signature
   IntegratorKind kind() const override { return IntegratorKind::Symplectic; }
   StepResult step(const Model& model, State& state, double h) override;
 
@@ -31,6 +37,8 @@ class SymplecticEuler final : public Integrator {
 
 class RungeKutta4 final : public Integrator {
  public:
+  RungeKutta4() = default;
+  explicit RungeKutta4(const SolverOptions&) {}  // nothing to set: the factory's uniform signature
   IntegratorKind kind() const override { return IntegratorKind::RK4; }
   StepResult step(const Model& model, State& state, double h) override;
 

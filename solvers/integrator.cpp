@@ -1,23 +1,19 @@
-#include "integrator.h"
+#include "solvers/integrator.h"
 
-#include "backward_euler.h"
-#include "cvode_integrator.h"
-#include "explicit_integrators.h"
+#include "solvers/backward_euler.h"
+#include "solvers/cvode_integrator.h"
+#include "solvers/explicit_integrators.h"
 
 namespace jello {
 
+// Built from the one table of integrators (src/integrator_name.h): each row names its class.
 std::unique_ptr<Integrator> makeIntegrator(IntegratorKind kind, const SolverOptions& options) {
   switch (kind) {
-    case IntegratorKind::Euler:
-      return std::make_unique<ExplicitEuler>();
-    case IntegratorKind::Symplectic:
-      return std::make_unique<SymplecticEuler>();
-    case IntegratorKind::RK4:
-      return std::make_unique<RungeKutta4>();
-    case IntegratorKind::Implicit:
-      return std::make_unique<BackwardEuler>(options.implicit);
-    case IntegratorKind::Cvode:
-      return std::make_unique<CvodeIntegrator>(options.cvode);
+#define JELLO_MAKE_INTEGRATOR(kind, name, fileName, Class, summary) \
+  case IntegratorKind::kind:                                        \
+    return std::make_unique<Class>(options);
+    JELLO_INTEGRATORS(JELLO_MAKE_INTEGRATOR)
+#undef JELLO_MAKE_INTEGRATOR
   }
   return nullptr;
 }

@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
-#include "integrator_name.h"
-#include "model.h"
-#include "solver_options.h"
-#include "state.h"
-#include "step_result.h"
+#include "solvers/solver_options.h"
+#include "solvers/step_result.h"
+#include "src/integrator_name.h"
+#include "src/model.h"
+#include "src/state.h"
 
 namespace jello {
 

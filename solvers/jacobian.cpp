@@ -1,8 +1,9 @@
-#include "jacobian.h"
+#include "solvers/jacobian.h"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
+
+#include "src/assertions.h"
 
 namespace jello {
 namespace {
@@ -12,13 +13,23 @@ int slotOf(const SparseMatrix& m, int row, int col) {
   const int* begin = m.innerIndexPtr() + m.outerIndexPtr()[col];
   const int* end = m.innerIndexPtr() + m.outerIndexPtr()[col + 1];
   const int* it = std::lower_bound(begin, end, row);
-  assert(it != end && *it == row);
+  JELLO_ASSERT(it != end && *it == row, "the entry is in the Jacobian's pattern");
   return static_cast<int>(it - m.innerIndexPtr());
 }
 
 // block += B, both 3x3 row-major.
 inline void addBlock(double* block, const double B[9]) {
   for (int e = 0; e < 9; ++e) block[e] += B[e];
+}
+
+// True when m equals its transpose to round-off (a costly check: JELLO_VALIDATE only). A matrix
+// with a non-finite entry passes: that is a diverging state, which Simulation reports, not a
+// structural error.
+[[maybe_unused]] bool isSymmetric(const SparseMatrix& m) {
+  const double scale = m.cwiseAbs().sum();
+  if (!std::isfinite(scale)) return true;
+  const SparseMatrix transposed = m.transpose();
+  return (m - transposed).cwiseAbs().sum() <= 1e-12 * scale;
 }
 
 }  // namespace
@@ -160,10 +171,12 @@ void JacobianAssembler::assemble(const double* x, const double* v, const Jacobia
     Kv[diagSlots_[i]] = diagK_[i];
     Dv[diagSlots_[i]] = diagD_[i];
   }
+  JELLO_VALIDATE(options.includeField || isSymmetric(K_), "K is symmetric without the field");
+  JELLO_VALIDATE(isSymmetric(D_), "D is symmetric");
 }
 
 void JacobianAssembler::combine(double alpha, double beta, SparseMatrix& A) const {
-  assert(A.nonZeros() == K_.nonZeros());
+  JELLO_ASSERT(A.nonZeros() == K_.nonZeros(), "A has the pattern of K");
   const double* Kv = K_.valuePtr();
   const double* Dv = D_.valuePtr();
   double* Av = A.valuePtr();

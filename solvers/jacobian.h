@@ -2,7 +2,7 @@
 // like the state, N/m and N*s/m), assembled into sparse matrices whose pattern is built once
 // and whose values are refilled in place at every state (no triplets, no re-analysis).
 //
-// Springs (physics.md), u = unit vector along the spring, P = u u^T, alpha = 1 - L0/l:
+// Springs (src/PHYSICS.md), u = unit vector along the spring, P = u u^T, alpha = 1 - L0/l:
 //   Ke = -k [ P + alpha (I - P) ]   on blocks (a,a), (b,b);  -Ke on (a,b), (b,a)
 //   De = -c P                        likewise
 // Under compression alpha < 0 and K gains positive directions, so M - h D - h^2 K can become
@@ -19,7 +19,7 @@
 #include <Eigen/SparseCore>
 #include <vector>
 
-#include "model.h"
+#include "src/model.h"
 
 namespace jello {
 

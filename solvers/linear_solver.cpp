@@ -1,4 +1,4 @@
-#include "linear_solver.h"
+#include "solvers/linear_solver.h"
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/IterativeLinearSolvers>

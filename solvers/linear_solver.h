@@ -15,8 +15,8 @@
 #include <string>
 #include <string_view>
 
-#include "jacobian.h"
-#include "step_result.h"
+#include "solvers/jacobian.h"
+#include "solvers/step_result.h"
 
 namespace jello {
 

@@ -1,7 +1,9 @@
-#include "simulation.h"
+#include "solvers/simulation.h"
 
 #include <cmath>
 #include <sstream>
+
+#include "src/assertions.h"
 
 namespace jello {
 
@@ -37,6 +39,8 @@ Simulation::Simulation(World world, std::optional<IntegratorKind> integrator,
 
 StepResult Simulation::step() {
   if (divergence_) return StepResult::failure(divergence_->describe());
+  JELLO_VALIDATE(std::isfinite(state_.x.sum() + state_.v.sum()),
+                 "the state handed to a step is finite");
   previous_ = state_;
   StepResult result = integrator_->step(model_, state_, dt_);
   std::optional<std::string> broken =

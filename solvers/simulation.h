@@ -7,10 +7,10 @@
 #include <optional>
 #include <string>
 
-#include "integrator.h"
-#include "model.h"
-#include "state.h"
-#include "world.h"
+#include "solvers/integrator.h"
+#include "src/model.h"
+#include "src/state.h"
+#include "src/world.h"
 
 namespace jello {
 
@@ -50,9 +50,9 @@ class Simulation {
 
   const World& world() const { return world_; }
   const Model& model() const { return model_; }
-  const Integrator& integratorState() const { return *integrator_; }
+  const Integrator& integrator() const { return *integrator_; }
+  IntegratorKind integratorKind() const { return integrator_->kind(); }
   const State& state() const { return state_; }
-  IntegratorKind integrator() const { return integrator_->kind(); }
   double dt() const { return dt_; }
   long steps() const { return steps_; }
   const std::optional<Divergence>& divergence() const { return divergence_; }

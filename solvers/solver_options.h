@@ -1,7 +1,7 @@
 // Settings of the implicit integrators, as plain structs (README "Implicit solvers").
 #pragma once
 
-#include "linear_solver.h"
+#include "solvers/linear_solver.h"
 
 namespace jello {
 

@@ -1,4 +1,4 @@
-#include "contact.h"
+#include "src/contact.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-// Penalty contact (physics.md): a point on the solid side of a surface gets a rest-length-0
+// Penalty contact (src/PHYSICS.md): a point on the solid side of a surface gets a rest-length-0
 // spring to its projection p on the surface,
 //   f = -kc (n.(x - p)) n - dc (n.v) n,   energy = 1/2 kc (n.(x - p))^2,
 // with n the unit normal pointing into free space. Walls: the six faces of the box [-2,2]^3,
@@ -6,7 +6,7 @@
 // solid inside, n radial.
 #pragma once
 
-#include "world.h"
+#include "src/world.h"
 
 namespace jello {
 

@@ -1,10 +1,10 @@
-#include "force_field.h"
+#include "src/force_field.h"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
 
-#include "contact.h"
+#include "src/assertions.h"
+#include "src/contact.h"
 
 namespace jello {
 namespace {
@@ -24,9 +24,10 @@ void locate(double coord, int res, int& cell, double& frac) {
 }  // namespace
 
 FieldForces::FieldForces(ForceField field) : field_(std::move(field)) {
-  assert(field_.resolution >= 2);
-  assert(field_.forces.size() ==
-         static_cast<std::size_t>(field_.resolution) * field_.resolution * field_.resolution);
+  JELLO_ASSERT(field_.resolution >= 2, "a field has at least 2 nodes per axis");
+  JELLO_ASSERT(field_.forces.size() == static_cast<std::size_t>(field_.resolution) *
+                                           field_.resolution * field_.resolution,
+               "a field holds res^3 forces");
   constant_ = field_.forces.front();
   uniform_ = std::all_of(field_.forces.begin(), field_.forces.end(),
                          [this](const Vec3& f) { return f == constant_; });

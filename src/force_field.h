@@ -1,11 +1,11 @@
-// The external force field (world-format.md): forces F (N) on res^3 nodes covering [-2,2]^3,
+// The external force field (worlds/FORMAT.md): forces F (N) on res^3 nodes covering [-2,2]^3,
 // node (i,j,k) at -2 + 4*(i,j,k)/(res-1), interpolated trilinearly between nodes. A point
 // outside the box takes the value at the nearest point of the box (its position is clamped).
 // A field whose nodes are all equal is a constant force and is applied as one (no
 // interpolation); an all-zero field is no effect at all (the Model leaves it out).
 #pragma once
 
-#include "world.h"
+#include "src/world.h"
 
 namespace jello {
 

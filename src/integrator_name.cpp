@@ -1,4 +1,4 @@
-#include "integrator_name.h"
+#include "src/integrator_name.h"
 
 #include <algorithm>
 #include <array>
@@ -11,19 +11,21 @@ struct NameEntry {
   IntegratorKind kind;
   std::string_view name;
   std::string_view fileName;
+  std::string_view summary;
 };
 
-constexpr std::array<NameEntry, 5> kNames{{
-    {IntegratorKind::Euler, "euler", "Euler"},
-    {IntegratorKind::Symplectic, "symplectic", "symplectic"},
-    {IntegratorKind::RK4, "rk4", "RK4"},
-    {IntegratorKind::Implicit, "implicit", "implicit"},
-    {IntegratorKind::Cvode, "cvode", "cvode"},
-}};
+constexpr NameEntry kNames[] = {
+#define JELLO_INTEGRATOR_ENTRY(kind, name, fileName, Class, summary) \
+  {IntegratorKind::kind, name, fileName, summary},
+    JELLO_INTEGRATORS(JELLO_INTEGRATOR_ENTRY)
+#undef JELLO_INTEGRATOR_ENTRY
+};
 
-constexpr std::array<IntegratorKind, kNames.size()> kKinds{
-    IntegratorKind::Euler, IntegratorKind::Symplectic, IntegratorKind::RK4,
-    IntegratorKind::Implicit, IntegratorKind::Cvode};
+constexpr IntegratorKind kKinds[] = {
+#define JELLO_INTEGRATOR_KIND(kind, name, fileName, Class, summary) IntegratorKind::kind,
+    JELLO_INTEGRATORS(JELLO_INTEGRATOR_KIND)
+#undef JELLO_INTEGRATOR_KIND
+};
 
 bool equalsIgnoreCase(std::string_view a, std::string_view b) {
   return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char p, char q) {
@@ -33,8 +35,7 @@ bool equalsIgnoreCase(std::string_view a, std::string_view b) {
 }
 
 const NameEntry& entry(IntegratorKind kind) {
-  return *std::find_if(kNames.begin(), kNames.end(),
-                       [kind](const NameEntry& e) { return e.kind == kind; });
+  return kNames[static_cast<int>(kind)];  // the enumerators count the table's rows from 0
 }
 
 }  // namespace
@@ -52,6 +53,10 @@ std::string_view integratorName(IntegratorKind kind) {
 
 std::string_view integratorFileName(IntegratorKind kind) {
   return entry(kind).fileName;
+}
+
+std::string_view integratorSummary(IntegratorKind kind) {
+  return entry(kind).summary;
 }
 
 std::span<const IntegratorKind> allIntegrators() {

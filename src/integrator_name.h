@@ -1,5 +1,7 @@
-// The one registry of integrator names. World files, jello-sim, the viewer and the experiments
-// all parse and print names through it, so a name accepted in one place is accepted everywhere.
+// The one table of integrators. World files, jello-sim, the viewer and the experiments parse
+// and print names through it, and solvers/integrator.cpp builds its factory from it, so an
+// integrator added here is known everywhere: one row, plus its class in solvers/
+// (src/ARCHITECTURE.md, "How to add an integrator").
 #pragma once
 
 #include <optional>
@@ -9,12 +11,22 @@
 
 namespace jello {
 
+// Each row: enumerator, canonical name (lowercase; accepted in any case), the spelling written
+// to world files (the original course files say "Euler" and "RK4"), the class in solvers/ that
+// implements it (constructed from SolverOptions), and a one-line summary.
+#define JELLO_INTEGRATORS(X)                                                             \
+  X(Euler, "euler", "Euler", ExplicitEuler, "explicit (forward) Euler, as the original") \
+  X(Symplectic, "symplectic", "symplectic", SymplecticEuler,                             \
+    "semi-implicit Euler: v from the old state, then x from the new v")                  \
+  X(RK4, "rk4", "RK4", RungeKutta4, "classical fourth-order Runge-Kutta")                \
+  X(Implicit, "implicit", "implicit", BackwardEuler,                                     \
+    "backward Euler through the sparse spring Jacobian (Baraff & Witkin)")               \
+  X(Cvode, "cvode", "cvode", CvodeIntegrator, "SUNDIALS CVODE, variable-order stiff BDF")
+
 enum class IntegratorKind {
-  Euler,       // explicit (forward) Euler, as the original assignment
-  Symplectic,  // semi-implicit Euler: v from the old state, then x from the new v
-  RK4,         // classical fourth-order Runge-Kutta
-  Implicit,    // backward Euler through the sparse spring Jacobian (Baraff & Witkin)
-  Cvode,       // SUNDIALS CVODE, variable-order stiff BDF
+#define JELLO_INTEGRATOR_ENUMERATOR(kind, name, fileName, Class, summary) kind,
+  JELLO_INTEGRATORS(JELLO_INTEGRATOR_ENUMERATOR)
+#undef JELLO_INTEGRATOR_ENUMERATOR
 };
 
 // Case-insensitive: "RK4", "rk4", "Euler", "EULER", "symplectic" ...
@@ -26,6 +38,10 @@ std::string_view integratorName(IntegratorKind kind);
 // The spelling the original course files use ("Euler", "RK4"); our own names otherwise.
 std::string_view integratorFileName(IntegratorKind kind);
 
+// One line saying what the integrator is, for help texts.
+std::string_view integratorSummary(IntegratorKind kind);
+
+// Every integrator, in the table's order (the viewer's number keys follow it).
 std::span<const IntegratorKind> allIntegrators();
 
 // "euler, symplectic, rk4, implicit, cvode": for help texts and error messages.

@@ -1,4 +1,4 @@
-#include "lattice.h"
+#include "src/lattice.h"
 
 namespace jello {
 namespace {

@@ -4,14 +4,14 @@
 //   face shear  6 face diagonals        6 N (N-1)^2   springs, rest sqrt(2)/(N-1)
 //   body shear  4 body diagonals        4 (N-1)^3     springs, rest sqrt(3)/(N-1)
 //   bend        3 second axis offsets   3 N^2 (N-2)   springs, rest 2/(N-1)
-// (physics.md; for N = 8: 1344 + 2352 + 1372 + 1152 = 6220.) Rest lengths always come from this
+// (src/PHYSICS.md; for N = 8: 1344 + 2352 + 1372 + 1152 = 6220.) Rest lengths always come from this
 // ideal lattice, never from a file's initial positions.
 #pragma once
 
 #include <array>
 #include <span>
 
-#include "vec3.h"
+#include "src/vec3.h"
 
 namespace jello {
 

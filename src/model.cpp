@@ -1,8 +1,9 @@
-#include "model.h"
+#include "src/model.h"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
+
+#include "src/assertions.h"
 
 namespace jello {
 
@@ -21,7 +22,7 @@ ModelSpec modelSpecFromWorld(const World& world) {
 
 Model::Model(ModelSpec spec)
     : n_(spec.numPoints), mass_(spec.mass), springs_(std::move(spec.springs), spec.numPoints) {
-  assert(n_ > 0 && mass_ > 0.0);
+  JELLO_ASSERT(n_ > 0 && mass_ > 0.0, "a model has points of positive mass");
   if (spec.walls) walls_.emplace(spec.contact);
   if (spec.plane) plane_.emplace(*spec.plane, spec.contact);
   if (spec.sphere) sphere_.emplace(*spec.sphere, spec.contact);
@@ -34,35 +35,42 @@ Model::Model(ModelSpec spec)
 void Model::forces(const double* x, const double* v, double* f) const {
   std::fill(f, f + 3 * n_, 0.0);
   springs_.accumulate(x, v, f);
-  ++counts_.springs;
+  counters_->springs.fetch_add(1, std::memory_order_relaxed);
   if (walls_) {
     if (WallContact::allInside(x, n_)) {
-      ++counts_.wallsSkipped;
+      counters_->wallsSkipped.fetch_add(1, std::memory_order_relaxed);
     } else {
       walls_->accumulate(x, v, f, n_);
-      ++counts_.walls;
+      counters_->walls.fetch_add(1, std::memory_order_relaxed);
     }
   }
   if (plane_) {
     plane_->accumulate(x, v, f, n_);
-    ++counts_.plane;
+    counters_->plane.fetch_add(1, std::memory_order_relaxed);
   }
   if (sphere_) {
     sphere_->accumulate(x, v, f, n_);
-    ++counts_.sphere;
+    counters_->sphere.fetch_add(1, std::memory_order_relaxed);
   }
   if (field_) {
     field_->accumulate(x, f, n_);
-    ++counts_.field;
+    counters_->field.fetch_add(1, std::memory_order_relaxed);
   }
   if (userForce_) {
     for (int i = 0; i < 3 * n_; ++i) f[i] += (*userForce_)[i];
-    ++counts_.user;
+    counters_->user.fetch_add(1, std::memory_order_relaxed);
   }
 }
 
+EffectCounts Model::counts() const {
+  const auto get = [](const std::atomic<long>& c) { return c.load(std::memory_order_relaxed); };
+  const Counters& c = *counters_;
+  return {get(c.springs), get(c.walls), get(c.wallsSkipped), get(c.plane),
+          get(c.sphere),  get(c.field), get(c.user)};
+}
+
 void Model::setUserForce(const Eigen::VectorXd& f) {
-  assert(f.size() == 3 * n_);
+  JELLO_ASSERT(f.size() == 3 * n_, "a user force holds 3n values");
   userForce_ = f;
 }
 
@@ -73,14 +81,14 @@ void Model::acceleration(const double* x, const double* v, double* a) const {
 }
 
 void Model::forces(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& f) const {
-  assert(x.size() == 3 * n_ && v.size() == 3 * n_);
+  JELLO_ASSERT(x.size() == 3 * n_ && v.size() == 3 * n_, "a state holds 3n values");
   f.resize(3 * n_);
   forces(x.data(), v.data(), f.data());
 }
 
 void Model::acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
                          Eigen::VectorXd& a) const {
-  assert(x.size() == 3 * n_ && v.size() == 3 * n_);
+  JELLO_ASSERT(x.size() == 3 * n_ && v.size() == 3 * n_, "a state holds 3n values");
   a.resize(3 * n_);
   acceleration(x.data(), v.data(), a.data());
 }

@@ -7,14 +7,16 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <atomic>
+#include <memory>
 #include <optional>
 #include <vector>
 
-#include "contact.h"
-#include "force_field.h"
-#include "spring_forces.h"
-#include "state.h"
-#include "world.h"
+#include "src/contact.h"
+#include "src/force_field.h"
+#include "src/spring_forces.h"
+#include "src/state.h"
+#include "src/world.h"
 
 namespace jello {
 
@@ -40,6 +42,7 @@ struct Energy {
 };
 
 // How often each effect was evaluated: lets tests check that absent effects cost nothing.
+// A snapshot of the model's counters, which are atomic (threads may share a model).
 struct EffectCounts {
   long springs = 0;
   long walls = 0;
@@ -58,7 +61,9 @@ class Model {
   int numPoints() const { return n_; }
   double mass() const { return mass_; }
 
-  // f = total force (N) at state (x, v); all arrays 3n, component-major.
+  // f = total force (N) at state (x, v); all arrays 3n, component-major. The model keeps no
+  // scratch: several threads may evaluate one model at once (only its counters change, and
+  // they are atomic).
   void forces(const double* x, const double* v, double* f) const;
   // a = f / m (m/s^2).
   void acceleration(const double* x, const double* v, double* a) const;
@@ -88,7 +93,7 @@ class Model {
   bool hasPlane() const { return plane_.has_value(); }
   bool hasSphere() const { return sphere_.has_value(); }
   bool hasField() const { return field_.has_value(); }
-  const EffectCounts& counts() const { return counts_; }
+  EffectCounts counts() const;
 
   // A force a user applies from outside (the viewer's mouse drag): f (N), 3n component-major,
   // constant in x and v, so it adds nothing to the Jacobians. Absent until set; clearing it
@@ -106,7 +111,11 @@ class Model {
   std::optional<SphereContact> sphere_;
   std::optional<FieldForces> field_;
   std::optional<Eigen::VectorXd> userForce_;
-  mutable EffectCounts counts_;
+  struct Counters {
+    std::atomic<long> springs{0}, walls{0}, wallsSkipped{0}, plane{0}, sphere{0}, field{0}, user{0};
+  };
+  // unique_ptr keeps the model movable; relaxed increments: counts, not synchronization.
+  std::unique_ptr<Counters> counters_ = std::make_unique<Counters>();
 };
 
 }  // namespace jello

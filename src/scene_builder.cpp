@@ -1,11 +1,11 @@
-#include "scene_builder.h"
+#include "src/scene_builder.h"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
 #include <numbers>
 
-#include "lattice.h"
+#include "src/assertions.h"
+#include "src/lattice.h"
 
 namespace jello {
 namespace {
@@ -127,7 +127,7 @@ World buildWorld(const SceneSpec& spec) {
 }
 
 World resampleCube(const World& world, int n) {
-  assert(n >= 2);
+  JELLO_ASSERT(n >= 2, "a cube has at least 2 points per edge");
   const int m = world.cubeResolution;
   if (n == m) return world;
   const Lattice from{m};

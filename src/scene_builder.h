@@ -4,7 +4,7 @@
 
 #include <optional>
 
-#include "world.h"
+#include "src/world.h"
 
 namespace jello {
 

@@ -1,8 +1,9 @@
-#include "spring_forces.h"
+#include "src/spring_forces.h"
 
 #include <algorithm>
-#include <cassert>
 #include <cmath>
+
+#include "src/assertions.h"
 
 namespace jello {
 
@@ -43,16 +44,12 @@ std::vector<SpringGroup> latticeSpringGroups(const Lattice& lat, double stiffnes
 
 SpringForces::SpringForces(std::vector<SpringGroup> groups, int numPoints)
     : groups_(std::move(groups)), n_(numPoints) {
-  std::size_t longest = 0;
   for (const SpringGroup& g : groups_) {
-    assert(g.delta > 0 && g.first >= 0);
-    assert(g.first + static_cast<int>(g.mask.size()) + g.delta <= n_);
+    JELLO_ASSERT(g.delta > 0 && g.first >= 0, "a spring group links a point to a later one");
+    JELLO_ASSERT(g.first + static_cast<int>(g.mask.size()) + g.delta <= n_,
+                 "a spring group reaches past the last point");
     numSprings_ += g.numSprings;
-    longest = std::max(longest, g.mask.size());
   }
-  gx_.resize(longest);
-  gy_.resize(longest);
-  gz_.resize(longest);
 }
 
 namespace {
@@ -96,17 +93,17 @@ void accumulateGroupFused(const SpringGroup& g, std::ptrdiff_t count, const doub
 // One group: springs p -> p + delta for the base points p = first .. first + count - 1. The
 // arrays are passed as separate restrict pointers, offset to the group's base and partner
 // points, so the compiler sees unit-stride loops without aliasing and vectorizes them.
-void accumulateGroup(const SpringGroup& g, std::ptrdiff_t count, const double* __restrict xp,
-                     const double* __restrict yp, const double* __restrict zp,
-                     const double* __restrict xq, const double* __restrict yq,
-                     const double* __restrict zq, const double* __restrict vxp,
-                     const double* __restrict vyp, const double* __restrict vzp,
-                     const double* __restrict vxq, const double* __restrict vyq,
-                     const double* __restrict vzq, double* __restrict fxp, double* __restrict fyp,
-                     double* __restrict fzp, double* __restrict gx, double* __restrict gy,
-                     double* __restrict gz) {
+void accumulateGroup(const SpringGroup& g, std::ptrdiff_t first, std::ptrdiff_t count,
+                     const double* __restrict xp, const double* __restrict yp,
+                     const double* __restrict zp, const double* __restrict xq,
+                     const double* __restrict yq, const double* __restrict zq,
+                     const double* __restrict vxp, const double* __restrict vyp,
+                     const double* __restrict vzp, const double* __restrict vxq,
+                     const double* __restrict vyq, const double* __restrict vzq,
+                     double* __restrict fxp, double* __restrict fyp, double* __restrict fzp,
+                     double* __restrict gx, double* __restrict gy, double* __restrict gz) {
   const double k = g.stiffness, c = g.damping, L0 = g.rest;
-  const double* __restrict mask = g.mask.data();
+  const double* __restrict mask = g.mask.data() + first;
   // Pass 1: the force on each base point, added in place (base points run unit-stride).
   for (std::ptrdiff_t s = 0; s < count; ++s) {
     const double dx = xq[s] - xp[s], dy = yq[s] - yp[s], dz = zq[s] - zp[s];
@@ -136,19 +133,37 @@ void subtractFromPartners(std::ptrdiff_t count, const double* __restrict gx,
 
 void SpringForces::accumulate(const double* x, const double* v, double* f) const {
   const int n = n_;
+  // The base points' forces of a group with a short offset are kept for the partners' pass in
+  // two chunk buffers on the stack (no state in the object, so threads may share it). The
+  // partners' pass of a chunk runs after the next chunk's base pass: a partner q = p + delta
+  // (delta < kChunk) is a base point of the same or the next chunk, so every point receives its
+  // base force before its partner force, the order of a single pass over the whole group, and
+  // the sums are bit for bit those of the unchunked loop.
+  constexpr std::ptrdiff_t kChunk = 128;
+  static_assert(kChunk >= kFusedMinDelta);
+  alignas(64) double buffer[2][3][kChunk];
   for (const SpringGroup& g : groups_) {
     const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(g.mask.size());
-    const int p = g.first, q = g.first + g.delta;
+    const std::ptrdiff_t p = g.first, q = g.first + g.delta;
     if (g.delta >= kFusedMinDelta) {
       accumulateGroupFused(g, count, x + p, x + n + p, x + 2 * n + p, v + p, v + n + p,
                            v + 2 * n + p, f + p, f + n + p, f + 2 * n + p);
       continue;
     }
-    accumulateGroup(g, count, x + p, x + n + p, x + 2 * n + p, x + q, x + n + q, x + 2 * n + q,
-                    v + p, v + n + p, v + 2 * n + p, v + q, v + n + q, v + 2 * n + q, f + p,
-                    f + n + p, f + 2 * n + p, gx_.data(), gy_.data(), gz_.data());
-    subtractFromPartners(count, gx_.data(), gy_.data(), gz_.data(), f + q, f + n + q,
-                         f + 2 * n + q);
+    const auto partners = [&](std::ptrdiff_t s0, int b) {
+      const std::ptrdiff_t len = std::min(kChunk, count - s0), o = q + s0;
+      subtractFromPartners(len, buffer[b][0], buffer[b][1], buffer[b][2], f + o, f + n + o,
+                           f + 2 * n + o);
+    };
+    int b = 0;
+    for (std::ptrdiff_t s0 = 0; s0 < count; s0 += kChunk, b ^= 1) {
+      const std::ptrdiff_t len = std::min(kChunk, count - s0), a = p + s0, c = q + s0;
+      accumulateGroup(g, s0, len, x + a, x + n + a, x + 2 * n + a, x + c, x + n + c, x + 2 * n + c,
+                      v + a, v + n + a, v + 2 * n + a, v + c, v + n + c, v + 2 * n + c, f + a,
+                      f + n + a, f + 2 * n + a, buffer[b][0], buffer[b][1], buffer[b][2]);
+      if (s0 > 0) partners(s0 - kChunk, b ^ 1);
+    }
+    if (count > 0) partners((count - 1) / kChunk * kChunk, b ^ 1);
   }
 }
 

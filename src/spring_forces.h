@@ -1,4 +1,4 @@
-// Elastic springs: Hooke plus damping projected on the spring (physics.md).
+// Elastic springs: Hooke plus damping projected on the spring (src/PHYSICS.md).
 //   d = x_q - x_p, l = |d|, w = v_q - v_p
 //   f_p = [ k (1 - L0/l) + c (d.w)/l^2 ] d,   f_q = -f_p
 //   energy = 1/2 k (l - L0)^2
@@ -10,7 +10,7 @@
 
 #include <vector>
 
-#include "lattice.h"
+#include "src/lattice.h"
 
 namespace jello {
 
@@ -41,7 +41,8 @@ class SpringForces {
  public:
   SpringForces(std::vector<SpringGroup> groups, int numPoints);
 
-  // Adds the spring forces (N) of state (x, v) to f. All arrays component-major, 3n.
+  // Adds the spring forces (N) of state (x, v) to f. All arrays component-major, 3n. Keeps no
+  // state: threads may evaluate one SpringForces at once.
   void accumulate(const double* x, const double* v, double* f) const;
   double energy(const double* x) const;  // J
 
@@ -54,7 +55,6 @@ class SpringForces {
   std::vector<SpringGroup> groups_;
   int n_;
   int numSprings_ = 0;
-  mutable std::vector<double> gx_, gy_, gz_;  // per-group scratch: force on each base point
 };
 
 }  // namespace jello

@@ -1,12 +1,13 @@
-#include "state.h"
+#include "src/state.h"
 
-#include <cassert>
+#include "src/assertions.h"
 
 namespace jello {
 
 State initialState(const World& world) {
   const int n = world.numPoints();
-  assert(static_cast<int>(world.positions.size()) == n);
+  JELLO_ASSERT(static_cast<int>(world.positions.size()) == n,
+               "a world holds one position per point");
   State s;
   s.x.resize(3 * n);
   s.v.resize(3 * n);

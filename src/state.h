@@ -7,8 +7,8 @@
 
 #include <Eigen/Core>
 
-#include "vec3.h"
-#include "world.h"
+#include "src/vec3.h"
+#include "src/world.h"
 
 namespace jello {
 

@@ -1,12 +1,12 @@
-// The whole initial state of one jello scene, as a world file holds it (docs: README "World
-// files"). A World is plain data; loading checks it, building a Model turns it into effects.
+// The whole initial state of one jello scene, as a world file holds it (worlds/FORMAT.md). A
+// World is plain data; loading checks it, building a Model turns it into effects.
 #pragma once
 
 #include <optional>
 #include <vector>
 
-#include "integrator_name.h"
-#include "vec3.h"
+#include "src/integrator_name.h"
+#include "src/vec3.h"
 
 namespace jello {
 

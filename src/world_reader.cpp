@@ -1,4 +1,4 @@
-#include "world_reader.h"
+#include "src/world_reader.h"
 
 #include <charconv>
 #include <cmath>

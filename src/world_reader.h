@@ -9,7 +9,7 @@
 #include <string>
 #include <string_view>
 
-#include "world.h"
+#include "src/world.h"
 
 namespace jello {
 

@@ -1,8 +1,8 @@
-#include "world_writer.h"
+#include "src/world_writer.h"
 
 #include <cstdio>
 
-#include "atomic_file.h"
+#include "src/atomic_file.h"
 
 namespace jello {
 namespace {

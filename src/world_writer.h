@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string>
 
-#include "world.h"
+#include "src/world.h"
 
 namespace jello {
 

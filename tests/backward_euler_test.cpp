@@ -1,13 +1,13 @@
 // Backward Euler: its exact energy loss, order of convergence, Newton residual, linear solvers.
-#include "backward_euler.h"
+#include "solvers/backward_euler.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "explicit_integrators.h"
-#include "scene_builder.h"
-#include "test_support.h"
+#include "solvers/explicit_integrators.h"
+#include "src/scene_builder.h"
+#include "tests/test_support.h"
 
 namespace jello {
 namespace {

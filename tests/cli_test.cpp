@@ -6,11 +6,11 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "atomic_file.h"
-#include "scene_builder.h"
-#include "test_support.h"
-#include "world_reader.h"
-#include "world_writer.h"
+#include "src/atomic_file.h"
+#include "src/scene_builder.h"
+#include "src/world_reader.h"
+#include "src/world_writer.h"
+#include "tests/test_support.h"
 
 namespace jello {
 namespace {

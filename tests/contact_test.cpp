@@ -1,5 +1,5 @@
 // Penalty contact: direction, magnitude, and consistency with its energy.
-#include "contact.h"
+#include "src/contact.h"
 
 #include <gtest/gtest.h>
 

@@ -3,10 +3,10 @@
 
 #include <map>
 
-#include "cvode_integrator.h"
-#include "explicit_integrators.h"
-#include "simulation.h"
-#include "test_support.h"
+#include "solvers/cvode_integrator.h"
+#include "solvers/explicit_integrators.h"
+#include "solvers/simulation.h"
+#include "tests/test_support.h"
 
 namespace jello {
 namespace {

@@ -10,16 +10,16 @@
 #include <numbers>
 #include <sstream>
 
-#include "scene_builder.h"
-#include "simulation.h"
-#include "stability_analysis.h"
-#include "test_support.h"
+#include "experiments/studies/stability_analysis.h"
+#include "solvers/simulation.h"
+#include "src/scene_builder.h"
+#include "tests/test_support.h"
 
 namespace jello::experiments {
 namespace {
 
 TEST(StabilityAnalysis, WMaxOfTheLatticeAtRestIsTheDenseSolvesValue) {
-  // physics.md: w_max = 4.0715 sqrt(k/m) for the full 8^3 lattice at rest.
+  // src/PHYSICS.md: w_max = 4.0715 sqrt(k/m) for the full 8^3 lattice at rest.
   World w = buildWorld(stiffCube(1e4));
   const Lattice lattice{8};
   for (int i = 0; i < 8; ++i) {

@@ -1,13 +1,13 @@
 // Trilinear interpolation of the force field.
-#include "force_field.h"
+#include "src/force_field.h"
 
 #include <gtest/gtest.h>
 
 #include <limits>
 #include <random>
 
-#include "scene_builder.h"
-#include "test_support.h"
+#include "src/scene_builder.h"
+#include "tests/test_support.h"
 
 namespace jello {
 namespace {

@@ -6,8 +6,8 @@
 
 #include <cmath>
 
-#include "scene_builder.h"
-#include "simulation.h"
+#include "solvers/simulation.h"
+#include "src/scene_builder.h"
 
 namespace jello {
 namespace {

@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "explicit_integrators.h"
-#include "test_support.h"
+#include "solvers/explicit_integrators.h"
+#include "tests/test_support.h"
 
 namespace jello {
 namespace {

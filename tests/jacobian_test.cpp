@@ -1,13 +1,13 @@
 // Assembled Jacobians against central differences of the forces, effect by effect.
-#include "jacobian.h"
+#include "solvers/jacobian.h"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <random>
 
-#include "scene_builder.h"
-#include "test_support.h"
+#include "src/scene_builder.h"
+#include "tests/test_support.h"
 
 namespace jello {
 namespace {

@@ -4,7 +4,7 @@
 #include <set>
 #include <utility>
 
-#include "spring_forces.h"
+#include "src/spring_forces.h"
 
 namespace jello {
 namespace {

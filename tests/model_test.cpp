@@ -1,10 +1,15 @@
 // The model builds only the effects a scene has, and absent effects are never evaluated.
-#include "model.h"
+#include "src/model.h"
 
 #include <gtest/gtest.h>
 
-#include "scene_builder.h"
-#include "test_support.h"
+#include <atomic>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include "src/scene_builder.h"
+#include "tests/test_support.h"
 
 namespace jello {
 namespace {
@@ -97,6 +102,40 @@ TEST(Model, EnergyAddsKineticSpringAndContact) {
   EXPECT_NEAR(e.contact, 0.5 * 400 * 0.1 * 0.1, 1e-12);
   EXPECT_GT(e.spring, 0.0);
   EXPECT_DOUBLE_EQ(e.total(), e.kinetic + e.spring + e.contact);
+}
+
+// Model::forces is const and keeps no scratch: two threads evaluating one model at different
+// states get, bit for bit, what one thread gets (a shared scratch buffer would mix the states).
+TEST(Model, TwoThreadsEvaluatingOneModelGetWhatOneThreadGets) {
+  const World w = test::loadWorld("jello.w");
+  const Model model(w);
+  std::mt19937 rng(7);
+  std::normal_distribution<double> jitter(0.0, 0.02);
+  std::vector<State> states(4, initialState(w));
+  std::vector<Eigen::VectorXd> expected(states.size());
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    for (Eigen::Index j = 0; j < states[i].x.size(); ++j) {
+      states[i].x[j] += jitter(rng);
+      states[i].v[j] += jitter(rng);
+    }
+    model.forces(states[i].x, states[i].v, expected[i]);
+  }
+  const long before = model.counts().springs;
+  constexpr int kRounds = 300;
+  std::atomic<int> mismatches{0};
+  const auto work = [&](std::size_t offset) {
+    Eigen::VectorXd f;
+    for (int r = 0; r < kRounds; ++r) {
+      const std::size_t i = (offset + static_cast<std::size_t>(r)) % states.size();
+      model.forces(states[i].x, states[i].v, f);
+      if (f != expected[i]) ++mismatches;
+    }
+  };
+  std::thread other(work, 1);
+  work(0);
+  other.join();
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_EQ(model.counts().springs - before, 2 * kRounds);  // counters are atomic
 }
 
 }  // namespace

@@ -9,11 +9,11 @@
 #include <random>
 #include <sstream>
 
-#include "scene_builder.h"
-#include "simulation.h"
-#include "test_support.h"
-#include "world_reader.h"
-#include "world_writer.h"
+#include "solvers/simulation.h"
+#include "src/scene_builder.h"
+#include "src/world_reader.h"
+#include "src/world_writer.h"
+#include "tests/test_support.h"
 
 namespace jello {
 namespace {

@@ -1,13 +1,13 @@
 // The simulation loop: integrator choice, divergence detection, saving the state.
-#include "simulation.h"
+#include "solvers/simulation.h"
 
 #include <gtest/gtest.h>
 
 #include <limits>
 
-#include "test_support.h"
-#include "world_reader.h"
-#include "world_writer.h"
+#include "src/world_reader.h"
+#include "src/world_writer.h"
+#include "tests/test_support.h"
 
 namespace jello {
 namespace {
@@ -22,10 +22,10 @@ World stiff(double k) {
 TEST(Simulation, UsesTheWorldsIntegratorAndDtUnlessOverridden) {
   const World w = test::loadWorld("rotate.w");
   const Simulation a(w);
-  EXPECT_EQ(a.integrator(), IntegratorKind::RK4);
+  EXPECT_EQ(a.integratorKind(), IntegratorKind::RK4);
   EXPECT_EQ(a.dt(), 0.001);
   const Simulation b(w, IntegratorKind::Symplectic, 1e-4);
-  EXPECT_EQ(b.integrator(), IntegratorKind::Symplectic);
+  EXPECT_EQ(b.integratorKind(), IntegratorKind::Symplectic);
   EXPECT_EQ(b.dt(), 1e-4);
 }
 
@@ -67,7 +67,7 @@ TEST(Simulation, SwitchingIntegratorKeepsTheState) {
   for (int i = 0; i < 10; ++i) ASSERT_TRUE(sim.step().ok);
   const State before = sim.state();
   sim.setIntegrator(IntegratorKind::Symplectic);
-  EXPECT_EQ(sim.integrator(), IntegratorKind::Symplectic);
+  EXPECT_EQ(sim.integratorKind(), IntegratorKind::Symplectic);
   EXPECT_EQ(sim.state().x, before.x);
   ASSERT_TRUE(sim.step().ok);
   EXPECT_NEAR(sim.state().t, before.t + sim.dt(), 1e-15);
@@ -120,6 +120,22 @@ TEST(Simulation, EveryReferenceWorldRunsATenthOfASecondWithItsOwnSettings) {
   }
   Simulation skewed(test::loadWorld("skewedCorner.w"));  // dt = 1e-5: 0.01 s is 1000 steps
   for (int i = 0; i < 1000; ++i) ASSERT_TRUE(skewed.step().ok);
+}
+
+// The one table of integrators (src/integrator_name.h): every row parses from its name and its
+// file spelling, has a summary, and the factory builds its class.
+TEST(IntegratorTable, EveryRowParsesBuildsAndNamesItself) {
+  ASSERT_FALSE(allIntegrators().empty());
+  for (IntegratorKind kind : allIntegrators()) {
+    SCOPED_TRACE(std::string(integratorName(kind)));
+    EXPECT_EQ(parseIntegratorName(integratorName(kind)), kind);
+    EXPECT_EQ(parseIntegratorName(integratorFileName(kind)), kind);
+    EXPECT_FALSE(integratorSummary(kind).empty());
+    EXPECT_NE(integratorNameList().find(integratorName(kind)), std::string::npos);
+    const std::unique_ptr<Integrator> integrator = makeIntegrator(kind);
+    ASSERT_NE(integrator, nullptr);
+    EXPECT_EQ(integrator->kind(), kind);
+  }
 }
 
 }  // namespace

@@ -8,8 +8,8 @@
 #include <fstream>
 #include <string>
 
-#include "simulation.h"
-#include "test_support.h"
+#include "solvers/simulation.h"
+#include "tests/test_support.h"
 
 namespace jello {
 namespace {

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <random>
 
-#include "explicit_integrators.h"
-#include "model.h"
-#include "test_support.h"
+#include "solvers/explicit_integrators.h"
+#include "src/model.h"
+#include "tests/test_support.h"
 
 namespace jello {
 namespace {

@@ -1,4 +1,4 @@
-#include "test_support.h"
+#include "tests/test_support.h"
 
 #include <sys/wait.h>
 
@@ -8,7 +8,7 @@
 #include <random>
 #include <sstream>
 
-#include "world_reader.h"
+#include "src/world_reader.h"
 
 namespace jello::test {
 

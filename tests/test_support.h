@@ -4,9 +4,9 @@
 #include <filesystem>
 #include <string>
 
-#include "model.h"
-#include "state.h"
-#include "world.h"
+#include "src/model.h"
+#include "src/state.h"
+#include "src/world.h"
 
 namespace jello::test {
 

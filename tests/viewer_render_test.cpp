@@ -8,11 +8,11 @@
 #include <cstdio>
 #include <cstdlib>
 
-#include "camera.h"
-#include "image_writer.h"
-#include "renderer.h"
-#include "state.h"
-#include "test_support.h"
+#include "src/state.h"
+#include "tests/test_support.h"
+#include "viewer/camera.h"
+#include "viewer/image_writer.h"
+#include "viewer/renderer.h"
 
 namespace jello::viewer {
 namespace {

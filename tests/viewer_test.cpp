@@ -6,15 +6,15 @@
 #include <fstream>
 #include <random>
 
-#include "box_geometry.h"
-#include "camera.h"
-#include "image_writer.h"
-#include "interaction.h"
-#include "surface.h"
-#include "test_support.h"
-#include "viewer_session.h"
-#include "viewer_state.h"
-#include "world_writer.h"
+#include "src/world_writer.h"
+#include "tests/test_support.h"
+#include "viewer/box_geometry.h"
+#include "viewer/camera.h"
+#include "viewer/image_writer.h"
+#include "viewer/interaction.h"
+#include "viewer/surface.h"
+#include "viewer/viewer_session.h"
+#include "viewer/viewer_state.h"
 
 namespace jello::viewer {
 namespace {
@@ -339,7 +339,7 @@ TEST(ViewerSession, AReloadOfABrokenFileKeepsTheRunningScene) {
   writeWorld(test::loadWorld("jello.w"), path);
   EXPECT_FALSE(session.reload().has_value());
   EXPECT_EQ(session.simulation().state().t, 0.0);
-  EXPECT_EQ(session.simulation().integrator(), IntegratorKind::Symplectic);  // overrides stay
+  EXPECT_EQ(session.simulation().integratorKind(), IntegratorKind::Symplectic);  // overrides stay
 }
 
 TEST(ViewerSession, AFrameAdvancesTheWorldsNTimesDtAndAPushMovesTheCube) {

@@ -1,5 +1,5 @@
 // The reader against the six reference worlds and every class of bad input.
-#include "world_reader.h"
+#include "src/world_reader.h"
 
 #include <gtest/gtest.h>
 
@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "scene_builder.h"
-#include "test_support.h"
-#include "world_writer.h"
+#include "src/scene_builder.h"
+#include "src/world_writer.h"
+#include "tests/test_support.h"
 
 namespace jello {
 namespace {

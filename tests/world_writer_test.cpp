@@ -1,5 +1,5 @@
 // The writer: exact round trips, the original creator's format, extensions, atomic replace.
-#include "world_writer.h"
+#include "src/world_writer.h"
 
 #include <gtest/gtest.h>
 
@@ -7,10 +7,10 @@
 #include <limits>
 #include <random>
 
-#include "atomic_file.h"
-#include "scene_builder.h"
-#include "test_support.h"
-#include "world_reader.h"
+#include "src/atomic_file.h"
+#include "src/scene_builder.h"
+#include "src/world_reader.h"
+#include "tests/test_support.h"
 
 namespace jello {
 namespace {

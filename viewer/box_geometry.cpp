@@ -1,9 +1,9 @@
-#include "box_geometry.h"
+#include "viewer/box_geometry.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "contact.h"
+#include "src/contact.h"
 
 namespace jello::viewer {
 

@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "world.h"
+#include "src/world.h"
 
 namespace jello::viewer {
 

@@ -10,7 +10,7 @@
 #include <numbers>
 #include <optional>
 
-#include "vec3.h"
+#include "src/vec3.h"
 
 namespace jello::viewer {
 

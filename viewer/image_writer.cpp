@@ -1,11 +1,11 @@
-#include "image_writer.h"
+#include "viewer/image_writer.h"
 
 #include <cstring>
 #include <memory>
 #include <stdexcept>
 #include <string>
 
-#include "atomic_file.h"
+#include "src/atomic_file.h"
 
 // stb is header-only: its implementation lives in this one file.
 #define STB_IMAGE_WRITE_IMPLEMENTATION

@@ -1,4 +1,4 @@
-#include "interaction.h"
+#include "viewer/interaction.h"
 
 #include <array>
 #include <cmath>

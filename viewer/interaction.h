@@ -12,10 +12,10 @@
 #include <span>
 #include <vector>
 
-#include "camera.h"
-#include "lattice.h"
-#include "state.h"
-#include "surface.h"
+#include "src/lattice.h"
+#include "src/state.h"
+#include "viewer/camera.h"
+#include "viewer/surface.h"
 
 namespace jello::viewer {
 

@@ -8,10 +8,10 @@
 #include <iostream>
 #include <regex>
 
-#include "runtime_environment.h"
-#include "viewer_app.h"
-#include "viewer_state.h"
-#include "world_reader.h"
+#include "solvers/solver_threads.h"
+#include "src/world_reader.h"
+#include "viewer/viewer_app.h"
+#include "viewer/viewer_state.h"
 
 namespace {
 
@@ -27,7 +27,7 @@ std::filesystem::path defaultWorld() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  jello::applyRuntimeEnvironment(argv);
+  jello::applySolverThreadSettings(argv);
   jello::viewer::ViewerOptions opt;
   std::string world = defaultWorld().string(), integrator, size = "640x480";
   CLI::App app{"jello: the interactive jello cube (OpenGL/GLUT viewer)"};

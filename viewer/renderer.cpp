@@ -1,4 +1,4 @@
-#include "renderer.h"
+#include "viewer/renderer.h"
 
 #include <algorithm>
 
@@ -7,7 +7,7 @@
 #include <GL/freeglut.h>
 #include <GL/gl.h>
 
-#include "contact.h"
+#include "src/contact.h"
 
 namespace jello::viewer {
 namespace {

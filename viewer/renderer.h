@@ -7,12 +7,12 @@
 #include <string>
 #include <vector>
 
-#include "box_geometry.h"
-#include "camera.h"
-#include "state.h"
-#include "surface.h"
-#include "viewer_state.h"
-#include "world.h"
+#include "src/state.h"
+#include "src/world.h"
+#include "viewer/box_geometry.h"
+#include "viewer/camera.h"
+#include "viewer/surface.h"
+#include "viewer/viewer_state.h"
 
 namespace jello::viewer {
 

@@ -1,4 +1,4 @@
-#include "surface.h"
+#include "viewer/surface.h"
 
 #include <algorithm>
 

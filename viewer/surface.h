@@ -7,9 +7,9 @@
 #include <array>
 #include <vector>
 
-#include "lattice.h"
-#include "spring_forces.h"
-#include "state.h"
+#include "src/lattice.h"
+#include "src/spring_forces.h"
+#include "src/state.h"
 
 namespace jello::viewer {
 

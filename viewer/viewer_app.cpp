@@ -1,4 +1,4 @@
-#include "viewer_app.h"
+#include "viewer/viewer_app.h"
 
 #include <GL/freeglut.h>
 #include <unistd.h>
@@ -10,10 +10,10 @@
 #include <iostream>
 #include <sstream>
 
-#include "image_writer.h"
-#include "interaction.h"
-#include "renderer.h"
-#include "viewer_state.h"
+#include "viewer/image_writer.h"
+#include "viewer/interaction.h"
+#include "viewer/renderer.h"
+#include "viewer/viewer_state.h"
 
 namespace jello::viewer {
 namespace {
@@ -83,7 +83,7 @@ class Viewer {
 std::string Viewer::hudLine() const {
   const Simulation& sim = session_.simulation();
   std::ostringstream os;
-  os << integratorName(sim.integrator()) << "  dt " << format("%.3g", sim.dt()) << " s  t "
+  os << integratorName(sim.integratorKind()) << "  dt " << format("%.3g", sim.dt()) << " s  t "
      << format("%.3f", sim.state().t) << " s  " << format("%.0f", fps_) << " fps  "
      << format("%.3g", realTimeFactor_) << "x real time  E "
      << format("%.4g", sim.model().energy(sim.state()).total()) << " J";
@@ -172,7 +172,7 @@ void Viewer::display() {
         std::printf("%d frames in %.3f s: %.1f frames/s (%s, %dx%d, %s, t = %.4g s; %s)\n",
                     framesDrawn_, elapsed, framesDrawn_ / elapsed,
                     view_.mode == DisplayMode::Shaded ? "shaded" : "wireframe", viewport_.width,
-                    viewport_.height, std::string(integratorName(sim.integrator())).c_str(),
+                    viewport_.height, std::string(integratorName(sim.integratorKind())).c_str(),
                     sim.state().t, renderer ? renderer : "unknown renderer");
       }
       return leave(sim.divergence() ? 3 : 0);

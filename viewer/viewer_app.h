@@ -6,10 +6,10 @@
 #include <filesystem>
 #include <optional>
 
-#include "camera.h"
-#include "integrator_name.h"
-#include "viewer_session.h"
-#include "world.h"
+#include "src/integrator_name.h"
+#include "src/world.h"
+#include "viewer/camera.h"
+#include "viewer/viewer_session.h"
 
 namespace jello::viewer {
 

@@ -1,7 +1,7 @@
-#include "viewer_session.h"
+#include "viewer/viewer_session.h"
 
-#include "interaction.h"
-#include "viewer_state.h"
+#include "viewer/interaction.h"
+#include "viewer/viewer_state.h"
 
 namespace jello::viewer {
 

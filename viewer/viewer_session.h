@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "box_geometry.h"
-#include "simulation.h"
-#include "surface.h"
-#include "world_reader.h"
+#include "solvers/simulation.h"
+#include "src/world_reader.h"
+#include "viewer/box_geometry.h"
+#include "viewer/surface.h"
 
 namespace jello::viewer {
 

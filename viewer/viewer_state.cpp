@@ -1,11 +1,10 @@
-#include "viewer_state.h"
+#include "viewer/viewer_state.h"
 
-#include <array>
 #include <cmath>
 #include <sstream>
 #include <vector>
 
-#include "interaction.h"
+#include "viewer/interaction.h"
 
 namespace jello::viewer {
 
@@ -75,8 +74,23 @@ KeyResult handleKey(ViewerState& s, unsigned char key) {
   return {};
 }
 
+namespace {
+
+// "1-5", "integrator: 1 euler, 2 symplectic, ... (same state)", from the integrator table.
+KeyBinding integratorKeys() {
+  const auto integrators = allIntegrators();
+  std::string action = "integrator:";
+  for (std::size_t i = 0; i < integrators.size(); ++i) {
+    action += (i ? ", " : " ") + std::to_string(i + 1) + " " +
+              std::string(integratorName(integrators[i]));
+  }
+  return {"1-" + std::to_string(integrators.size()), action + " (same state)"};
+}
+
+}  // namespace
+
 std::span<const KeyBinding> keyBindings() {
-  static constexpr std::array<KeyBinding, 18> table{{
+  static const std::vector<KeyBinding> table{
       {"right-drag", "rotate the camera"},
       {"left-drag", "push the whole cube in the dragged direction"},
       {"Shift+left-drag", "pull the surface point under the cursor (also left-drag in pull mode)"},
@@ -88,21 +102,21 @@ std::span<const KeyBinding> keyBindings() {
       {"s h b", "wireframe: structural, shear, bend springs on/off"},
       {"p", "pause/resume"},
       {".", "advance one frame while paused"},
-      {"1-5", "integrator: 1 euler, 2 symplectic, 3 rk4, 4 implicit, 5 cvode (same state)"},
+      integratorKeys(),
       {"+ -", "time step x2, /2 (simulated time per frame stays n*dt of the world)"},
       {"r", "reload the world file (a bad file keeps the running scene)"},
       {"f", "force-field arrows on/off"},
       {"i", "heads-up line on/off"},
       {"space", "save a screenshot (jello-NNN.jpg in the current directory)"},
       {"ESC", "quit"},
-  }};
+  };
   return table;
 }
 
 std::string keyTable() {
   std::ostringstream os;
   for (const KeyBinding& k : keyBindings()) {
-    os << "  " << k.keys << std::string(18 - std::string(k.keys).size(), ' ') << k.action << '\n';
+    os << "  " << k.keys << std::string(18 - k.keys.size(), ' ') << k.action << '\n';
   }
   return os.str();
 }

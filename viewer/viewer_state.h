@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "camera.h"
-#include "integrator_name.h"
+#include "src/integrator_name.h"
+#include "viewer/camera.h"
 
 namespace jello::viewer {
 
@@ -47,8 +47,8 @@ struct KeyResult {
 KeyResult handleKey(ViewerState& state, unsigned char key);
 
 struct KeyBinding {
-  const char* keys;
-  const char* action;
+  std::string keys;
+  std::string action;
 };
 // The key table, one source for --help, the README and the on-screen help.
 std::span<const KeyBinding> keyBindings();

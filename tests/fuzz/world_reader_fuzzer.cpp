@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "world_reader.h"
+#include "src/world_reader.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   // Small limits keep each input's allocations small; the limits themselves are tested.

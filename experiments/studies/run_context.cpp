@@ -1,55 +1,19 @@
-#include "experiment_io.h"
+#include "experiments/studies/run_context.h"
 
 #include <sys/utsname.h>
 #include <unistd.h>
 
-#include <atomic>
-#include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <exception>
 #include <fstream>
-#include <sstream>
 #include <thread>
 
-#include "atomic_file.h"
-#include "progress.h"
+#include "solvers/solver_threads.h"
+#include "src/atomic_file.h"
 
 namespace jello::experiments {
-
-CsvTable::CsvTable(std::vector<std::string> columns) : columns_(std::move(columns)) {}
-
-void CsvTable::add(std::vector<Cell> row) {
-  std::lock_guard lock(mutex_);
-  rows_.push_back(std::move(row));
-}
-
-std::string CsvTable::text() const {
-  std::lock_guard lock(mutex_);
-  std::ostringstream os;
-  for (std::size_t i = 0; i < columns_.size(); ++i) os << (i ? "," : "") << columns_[i];
-  os << '\n';
-  for (const auto& row : rows_) {
-    for (std::size_t i = 0; i < row.size(); ++i) {
-      if (i) os << ',';
-      if (const double* d = std::get_if<double>(&row[i])) {
-        char buf[32];
-        std::snprintf(buf, sizeof buf, "%.17g", *d);
-        os << buf;
-      } else if (const long* l = std::get_if<long>(&row[i])) {
-        os << *l;
-      } else {
-        os << std::get<std::string>(row[i]);
-      }
-    }
-    os << '\n';
-  }
-  return os.str();
-}
-
-void CsvTable::write(const std::filesystem::path& path) const {
-  writeFileAtomically(path, text());
-}
 
 namespace {
 
@@ -74,16 +38,6 @@ std::string cpuModel() {
 
 }  // namespace
 
-std::string loadedBlas() {
-  std::ifstream maps("/proc/self/maps");
-  for (std::string line; std::getline(maps, line);) {
-    for (const char* name : {"libopenblas", "libblis", "libmkl", "libblas.so"}) {
-      if (line.find(name) != std::string::npos) return line.substr(line.find('/'));
-    }
-  }
-  return "none loaded";
-}
-
 nlohmann::json runContext(int argc, char** argv) {
   std::vector<std::string> args(argv, argv + argc);
   const std::string git = std::string("git -C '") + JELLO_SOURCE_DIR + "' ";
@@ -100,7 +54,7 @@ nlohmann::json runContext(int argc, char** argv) {
       {"tree_modified", dirty},
       {"compiler", std::string(__VERSION__)},
       {"build_type", JELLO_BUILD_TYPE},
-      {"blas", loadedBlas()},
+      {"blas", jello::loadedBlas()},
       {"OPENBLAS_NUM_THREADS",
        std::getenv("OPENBLAS_NUM_THREADS") ? std::getenv("OPENBLAS_NUM_THREADS") : ""},
       {"OMP_THREAD_LIMIT", std::getenv("OMP_THREAD_LIMIT") ? std::getenv("OMP_THREAD_LIMIT") : ""},
@@ -129,48 +83,6 @@ bool writeResults(const std::string& program, const std::filesystem::path& dir,
     return false;
   }
   return true;
-}
-
-void parallelFor(int count, int jobs, const std::string& label, bool progress,
-                 const std::function<void(int)>& task) {
-  std::atomic<int> next{0}, done{0};
-  std::exception_ptr failure;
-  std::mutex failureMutex;
-  const auto worker = [&] {
-    for (int i; (i = next.fetch_add(1)) < count;) {
-      {
-        std::lock_guard lock(failureMutex);
-        if (failure) return;
-      }
-      try {
-        task(i);
-      } catch (...) {
-        std::lock_guard lock(failureMutex);
-        if (!failure) failure = std::current_exception();
-      }
-      ++done;
-    }
-  };
-  std::vector<std::thread> threads;
-  for (int t = 1; t < std::max(1, jobs); ++t) threads.emplace_back(worker);
-  // The calling thread works too, and draws the progress line between its tasks.
-  Progress bar(progress, label);
-  std::thread reporter;
-  std::atomic<bool> finished{false};
-  if (progress) {
-    reporter = std::thread([&] {
-      while (!finished) {
-        bar.report(done, count);
-        std::this_thread::sleep_for(std::chrono::milliseconds(200));
-      }
-    });
-  }
-  worker();
-  for (std::thread& t : threads) t.join();
-  finished = true;
-  if (reporter.joinable()) reporter.join();
-  bar.finish();
-  if (failure) std::rethrow_exception(failure);
 }
 
 }  // namespace jello::experiments

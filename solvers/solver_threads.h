@@ -8,14 +8,17 @@
 // implicit at dt 0.01 for 2 s: 3.8 s by default, 1.75 s single-threaded (sys time 3.3 -> 0.1 s).
 #pragma once
 
+#include <string>
+
 namespace jello {
 
 // Unless the user set them, sets OMP_THREAD_LIMIT=1, OPENBLAS_NUM_THREADS=1 and
 // OMP_WAIT_POLICY=passive, then re-executes this program with the same arguments. Returns
 // (doing nothing) when all are already set or the re-execution is impossible.
-void applyRuntimeEnvironment(char** argv);
+void applySolverThreadSettings(char** argv);
 
-// std::signal with its result checked: on failure it warns on stderr, naming `program`.
-void setSignalHandler(const char* program, int signo, void (*handler)(int));
+// Which BLAS this process loaded (CHOLMOD's supernodal factorization depends on it): the path
+// of its shared library, or "none loaded".
+std::string loadedBlas();
 
 }  // namespace jello

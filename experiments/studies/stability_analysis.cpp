@@ -1,4 +1,4 @@
-#include "stability_analysis.h"
+#include "experiments/studies/stability_analysis.h"
 
 #include <Spectra/MatOp/SparseSymMatProd.h>
 #include <Spectra/SymEigsSolver.h>
@@ -9,10 +9,10 @@
 #include <cstdint>
 #include <stdexcept>
 
-#include "contact.h"
-#include "jacobian.h"
-#include "scene_builder.h"
-#include "simulation.h"
+#include "solvers/jacobian.h"
+#include "solvers/simulation.h"
+#include "src/contact.h"
+#include "src/scene_builder.h"
 
 namespace jello::experiments {
 

@@ -1,5 +1,6 @@
-// Speed of the core (Google Benchmark; run on one core, e.g. `taskset -c 0 build/release/
-// experiments/benchmarks`). Figures are reported in the README with the machine.
+// Speed of the core (Google Benchmark; run on one core, e.g.
+// `taskset -c 0 build/release/bin/benchmarks`). Figures are reported in the README with the
+// machine.
 //   BM_SpringForces/N    one evaluation of every spring; items/s = spring evaluations/s
 //   BM_Step/<integrator>/N  one full step on jello.w resampled to N^3; items/s = steps/s
 #include <benchmark/benchmark.h>
@@ -9,11 +10,10 @@
 #include <memory>
 #include <string>
 
-#include "experiment_io.h"
-#include "runtime_environment.h"
-#include "scene_builder.h"
-#include "simulation.h"
-#include "world_reader.h"
+#include "solvers/simulation.h"
+#include "solvers/solver_threads.h"
+#include "src/scene_builder.h"
+#include "src/world_reader.h"
 
 namespace {
 
@@ -62,9 +62,9 @@ BENCHMARK_CAPTURE(BM_Step, symplectic, jello::IntegratorKind::Symplectic)->Arg(8
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Single-threaded BLAS and CHOLMOD (see runtime_environment.h).
-  jello::applyRuntimeEnvironment(argv);
-  benchmark::AddCustomContext("blas", jello::experiments::loadedBlas());
+  // Single-threaded BLAS and CHOLMOD (see solvers/solver_threads.h).
+  jello::applySolverThreadSettings(argv);
+  benchmark::AddCustomContext("blas", jello::loadedBlas());
   benchmark::AddCustomContext("OPENBLAS_NUM_THREADS", std::getenv("OPENBLAS_NUM_THREADS"));
   benchmark::AddCustomContext("OMP_THREAD_LIMIT", std::getenv("OMP_THREAD_LIMIT"));
   benchmark::AddCustomContext("OMP_WAIT_POLICY", std::getenv("OMP_WAIT_POLICY"));

@@ -1,15 +1,14 @@
-#include "runtime_environment.h"
+#include "solvers/solver_threads.h"
 
 #include <unistd.h>
 
-#include <csignal>
-#include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <initializer_list>
 
 namespace jello {
 
-void applyRuntimeEnvironment(char** argv) {
+void applySolverThreadSettings(char** argv) {
   bool changed = false;
   for (const char* name : {"OMP_THREAD_LIMIT", "OPENBLAS_NUM_THREADS"}) {
     if (!std::getenv(name)) changed |= ::setenv(name, "1", 0) == 0;
@@ -18,10 +17,14 @@ void applyRuntimeEnvironment(char** argv) {
   if (changed) ::execv("/proc/self/exe", argv);  // returns only on failure: run as we are
 }
 
-void setSignalHandler(const char* program, int signo, void (*handler)(int)) {
-  if (std::signal(signo, handler) == SIG_ERR) {
-    std::fprintf(stderr, "%s: warning: cannot set the handler of signal %d\n", program, signo);
+std::string loadedBlas() {
+  std::ifstream maps("/proc/self/maps");
+  for (std::string line; std::getline(maps, line);) {
+    for (const char* name : {"libopenblas", "libblis", "libmkl", "libblas.so"}) {
+      if (line.find(name) != std::string::npos) return line.substr(line.find('/'));
+    }
   }
+  return "none loaded";
 }
 
 }  // namespace jello

@@ -12,12 +12,12 @@
 #include <cmath>
 #include <filesystem>
 
-#include "backward_euler.h"
-#include "jacobian.h"
-#include "linear_solver.h"
-#include "scene_builder.h"
-#include "simulation.h"
-#include "world_reader.h"
+#include "solvers/backward_euler.h"
+#include "solvers/jacobian.h"
+#include "solvers/linear_solver.h"
+#include "solvers/simulation.h"
+#include "src/scene_builder.h"
+#include "src/world_reader.h"
 
 namespace {
 
@@ -134,7 +134,7 @@ void BM_CvodeOneSecond(benchmark::State& st, double rtol, LinearSolverKind kind)
   for (auto _ : st) {
     Simulation sim(jelloAt(8), IntegratorKind::Cvode, 0.01, options);
     if (!runOneSecond(sim)) st.SkipWithError("cvode failed");
-    for (const Statistic& s : sim.integratorState().statistics()) st.counters[s.name] = s.value;
+    for (const Statistic& s : sim.integrator().statistics()) st.counters[s.name] = s.value;
   }
 }
 BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e3_cholmod, 1e-3, LinearSolverKind::Cholmod)

@@ -9,11 +9,11 @@
 #include <string>
 #include <vector>
 
-#include "atomic_file.h"
-#include "runtime_environment.h"
-#include "scene_builder.h"
-#include "world_reader.h"
-#include "world_writer.h"
+#include "experiments/common/signal_handler.h"
+#include "src/atomic_file.h"
+#include "src/scene_builder.h"
+#include "src/world_reader.h"
+#include "src/world_writer.h"
 
 namespace {
 

@@ -11,11 +11,13 @@
 #include <iostream>
 #include <thread>
 
-#include "experiment_io.h"
-#include "runtime_environment.h"
-#include "scene_builder.h"
-#include "simulation.h"
-#include "stability_analysis.h"
+#include "experiments/studies/csv_table.h"
+#include "experiments/studies/parallel_for.h"
+#include "experiments/studies/run_context.h"
+#include "experiments/studies/stability_analysis.h"
+#include "solvers/simulation.h"
+#include "solvers/solver_threads.h"
+#include "src/scene_builder.h"
 
 namespace {
 
@@ -39,7 +41,7 @@ double statistic(const Integrator& integrator, const std::string& name) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  applyRuntimeEnvironment(argv);
+  applySolverThreadSettings(argv);
   std::vector<int> ns{8, 12, 16, 24, 32};
   double k = 1e4, budget = 3.0, implicitDt = 0.01, rtol = 1e-3;
   int jobs = int(std::max(1u, std::thread::hardware_concurrency()));
@@ -132,7 +134,7 @@ int main(int argc, char** argv) {
         wall = std::chrono::duration<double>(Clock::now() - t0).count();
       }
       const double simulated = sim.state().t;
-      const Integrator& integ = sim.integratorState();
+      const Integrator& integ = sim.integrator();
       const bool split = t.kind == IntegratorKind::Implicit || t.kind == IntegratorKind::Cvode;
       const auto perSecond = [&](const char* stat) {
         return split ? statistic(integ, stat) / simulated : std::nan("");

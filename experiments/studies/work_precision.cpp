@@ -11,12 +11,14 @@
 #include <iostream>
 #include <thread>
 
-#include "experiment_io.h"
-#include "runtime_environment.h"
-#include "scene_builder.h"
-#include "simulation.h"
-#include "stability_analysis.h"
-#include "world_reader.h"
+#include "experiments/studies/csv_table.h"
+#include "experiments/studies/parallel_for.h"
+#include "experiments/studies/run_context.h"
+#include "experiments/studies/stability_analysis.h"
+#include "solvers/simulation.h"
+#include "solvers/solver_threads.h"
+#include "src/scene_builder.h"
+#include "src/world_reader.h"
 
 namespace {
 
@@ -82,7 +84,7 @@ struct Task {
 }  // namespace
 
 int main(int argc, char** argv) {
-  applyRuntimeEnvironment(argv);
+  applySolverThreadSettings(argv);
   int levels = 7, jobs = int(std::max(1u, std::thread::hardware_concurrency()));
   double stiffK = 1e4;
   bool quick = false, quiet = false;

@@ -1,4 +1,4 @@
-#include "progress.h"
+#include "experiments/common/progress.h"
 
 #include <unistd.h>
 

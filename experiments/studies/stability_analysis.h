@@ -5,7 +5,7 @@
 // Linearized at the start state, the modes have w_j^2 = eig(-K/m) (uniform point mass m, so
 // M^-1/2 (-K) M^-1/2 = -K/m; K includes contact springs in touch). Spectra's Lanczos solver
 // finds the largest, w_max: a general eigen-solver is thrown off by the six rigid modes at 0.
-// Spring damping c = r k gives every mode the damping ratio zeta = r w / 2 (physics.md): the
+// Spring damping c = r k gives every mode the damping ratio zeta = r w / 2 (src/PHYSICS.md): the
 // mode's eigenvalues are lambda = w (-zeta +- i sqrt(1 - zeta^2)) (real when zeta > 1). A
 // method is stable at h when every mode w in (0, w_max] has amplification spectral radius <= 1:
 //   euler      R = 1 + z                                    (h <= r exactly when zeta <= 1)
@@ -18,10 +18,10 @@
 #include <string>
 #include <string_view>
 
-#include "integrator_name.h"
-#include "model.h"
-#include "solver_options.h"
-#include "world.h"
+#include "solvers/solver_options.h"
+#include "src/integrator_name.h"
+#include "src/model.h"
+#include "src/world.h"
 
 namespace jello::experiments {
 

@@ -9,10 +9,12 @@
 #include <iostream>
 #include <thread>
 
-#include "experiment_io.h"
-#include "runtime_environment.h"
-#include "simulation.h"
-#include "stability_analysis.h"
+#include "experiments/studies/csv_table.h"
+#include "experiments/studies/parallel_for.h"
+#include "experiments/studies/run_context.h"
+#include "experiments/studies/stability_analysis.h"
+#include "solvers/simulation.h"
+#include "solvers/solver_threads.h"
 
 namespace {
 
@@ -45,7 +47,7 @@ struct Point {
 }  // namespace
 
 int main(int argc, char** argv) {
-  applyRuntimeEnvironment(argv);
+  applySolverThreadSettings(argv);
   Options opt;
   CLI::App app{
       "jello-stability: largest stable time step per integrator and stiffness, "

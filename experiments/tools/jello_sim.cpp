@@ -13,13 +13,14 @@
 #include <sstream>
 #include <string>
 
-#include "atomic_file.h"
-#include "progress.h"
-#include "runtime_environment.h"
-#include "scene_builder.h"
-#include "simulation.h"
-#include "world_reader.h"
-#include "world_writer.h"
+#include "experiments/common/progress.h"
+#include "experiments/common/signal_handler.h"
+#include "solvers/simulation.h"
+#include "solvers/solver_threads.h"
+#include "src/atomic_file.h"
+#include "src/scene_builder.h"
+#include "src/world_reader.h"
+#include "src/world_writer.h"
 
 namespace {
 
@@ -111,7 +112,7 @@ int run(const Options& opt) {
   }
   const long total = static_cast<long>(wanted);
   const Energy start = sim.model().energy(sim.state());
-  const std::string name(jello::integratorName(sim.integrator()));
+  const std::string name(jello::integratorName(sim.integratorKind()));
 
   Trace trace(!opt.trace.empty());
   trace.row(sim);
@@ -153,7 +154,7 @@ int run(const Options& opt) {
       {"diverged", diverged},
       {"interrupted", interrupted != 0},
   };
-  const std::vector<jello::Statistic> solverStats = sim.integratorState().statistics();
+  const std::vector<jello::Statistic> solverStats = sim.integrator().statistics();
   for (const jello::Statistic& st : solverStats) stats["solver"][st.name] = st.value;
   if (interrupted) {
     std::fprintf(stderr, "jello-sim: interrupted (signal %d) at t = %g s, after step %ld of %ld\n",
@@ -209,7 +210,7 @@ int run(const Options& opt) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  jello::applyRuntimeEnvironment(argv);
+  jello::applySolverThreadSettings(argv);
   // A file-size limit (or a quota) must fail the write, which is reported and cleaned up, not
   // kill the process with a temporary file left behind.
   jello::setSignalHandler("jello-sim", SIGXFSZ, SIG_IGN);

@@ -1,0 +1,57 @@
+#include "experiments/studies/parallel_for.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "experiments/common/progress.h"
+
+namespace jello::experiments {
+
+void parallelFor(int count, int jobs, const std::string& label, bool progress,
+                 const std::function<void(int)>& task) {
+  std::atomic<int> next{0}, done{0};
+  std::exception_ptr failure;
+  std::mutex failureMutex;
+  const auto worker = [&] {
+    for (int i; (i = next.fetch_add(1)) < count;) {
+      {
+        std::lock_guard lock(failureMutex);
+        if (failure) return;
+      }
+      try {
+        task(i);
+      } catch (...) {
+        std::lock_guard lock(failureMutex);
+        if (!failure) failure = std::current_exception();
+      }
+      ++done;
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int t = 1; t < std::max(1, jobs); ++t) threads.emplace_back(worker);
+  // The calling thread works too, and draws the progress line between its tasks.
+  Progress bar(progress, label);
+  std::thread reporter;
+  std::atomic<bool> finished{false};
+  if (progress) {
+    reporter = std::thread([&] {
+      while (!finished) {
+        bar.report(done, count);
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
+      }
+    });
+  }
+  worker();
+  for (std::thread& t : threads) t.join();
+  finished = true;
+  if (reporter.joinable()) reporter.join();
+  bar.finish();
+  if (failure) std::rethrow_exception(failure);
+}
+
+}  // namespace jello::experiments

@@ -1,0 +1,25 @@
+// The record of an experiment run: a JSON sidecar beside its CSV saying how the numbers were
+// made (command line, source commit and whether the tree had changes, compiler, build type,
+// the BLAS this process loaded, thread settings, machine, date).
+#pragma once
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "experiments/studies/csv_table.h"
+
+namespace jello::experiments {
+
+nlohmann::json runContext(int argc, char** argv);
+void writeSidecar(const std::filesystem::path& path, const nlohmann::json& sidecar);
+
+// Writes `table` to DIR/NAME.csv, each of `extra` to DIR/NAME_<suffix>.csv and the sidecar
+// to DIR/NAME.json, creating DIR. On failure prints "<program>: error: ..." and returns false.
+bool writeResults(const std::string& program, const std::filesystem::path& dir,
+                  const std::string& name, const CsvTable& table, const nlohmann::json& sidecar,
+                  const std::vector<std::pair<std::string, const CsvTable*>>& extra = {});
+
+}  // namespace jello::experiments

@@ -1,0 +1,54 @@
+// The project's checks: JELLO_ASSERT and JELLO_VALIDATE abort with the condition where they are
+// on (debug and asan builds), evaluate nothing where they are off (release), and the checks
+// placed in the code fire on the errors they guard against.
+#include "src/assertions.h"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "solvers/simulation.h"
+#include "src/scene_builder.h"
+#include "tests/test_support.h"
+
+namespace jello {
+namespace {
+
+TEST(Assertions, AbortNamingTheConditionWhenOn) {
+  if (!kJelloAssertions) GTEST_SKIP() << "assertions are off in this build";
+  EXPECT_DEATH(JELLO_ASSERT(1 + 1 == 3, "arithmetic"),
+               "assertion failed: 1 \\+ 1 == 3 \\(arithmetic\\)");
+}
+
+TEST(Assertions, EvaluateNothingWhenOff) {
+  if (kJelloAssertions) GTEST_SKIP() << "assertions are on in this build";
+  int calls = 0;
+  JELLO_ASSERT(++calls == 1, "never evaluated");
+  EXPECT_EQ(calls, 0);
+}
+
+TEST(Assertions, AModelWithoutMassIsAProgrammingError) {
+  if (!kJelloAssertions) GTEST_SKIP() << "assertions are off in this build";
+  ModelSpec spec = test::singleSpring(1.0, 0.0, 1.0, 1.0);
+  spec.mass = 0.0;
+  EXPECT_DEATH(Model{spec}, "positive mass");
+}
+
+// A state that is not finite never reaches an integrator: Simulation keeps the last sane
+// state. Handing it one anyway (a world built in code with a NaN) trips the validation where it
+// is on, and is reported as a divergence at step 1 where it is off.
+TEST(Validations, ANonFiniteStateHandedToAStepIsCaught) {
+  World w = test::loadWorld("jello.w");
+  w.positions[3].x = std::numeric_limits<double>::quiet_NaN();
+  Simulation sim(w);
+  if (kJelloValidate) {
+    EXPECT_DEATH((void)sim.step(), "validation failed.*finite");
+  } else {
+    EXPECT_FALSE(sim.step().ok);
+    ASSERT_TRUE(sim.divergence());
+    EXPECT_EQ(sim.divergence()->step, 1);
+  }
+}
+
+}  // namespace
+}  // namespace jello
