@@ -43,20 +43,11 @@ class TempFile {
   bool committed_ = false;
 };
 
-}  // namespace
-
-void writeFileAtomically(const std::filesystem::path& path, std::string_view contents) {
-  TempFile tmp(path.string() + ".tmp.XXXXXX");
-  if (tmp.fd() < 0) fail(path, "cannot create a temporary file beside it", errno);
-
-  const mode_t mask = ::umask(0);
-  ::umask(mask);
-  if (::fchmod(tmp.fd(), 0666 & ~mask) != 0) fail(path, "fchmod", errno);
-
+void writeAll(const std::filesystem::path& path, int fd, std::string_view contents) {
   const char* data = contents.data();
   std::size_t left = contents.size();
   while (left > 0) {
-    const ssize_t n = ::write(tmp.fd(), data, left);
+    const ssize_t n = ::write(fd, data, left);
     if (n < 0) {
       if (errno == EINTR) continue;
       fail(path, "write", errno);
@@ -64,9 +55,67 @@ void writeFileAtomically(const std::filesystem::path& path, std::string_view con
     data += n;
     left -= static_cast<std::size_t>(n);
   }
+}
+
+// A device, FIFO or socket: written where it is, as a shell redirection would.
+void writeInPlace(const std::filesystem::path& path, std::string_view contents) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) fail(path, "open", errno);
+  try {
+    writeAll(path, fd, contents);
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
+  if (::close(fd) != 0) fail(path, "close", errno);
+}
+
+// The file a chain of symbolic links ends at (the path itself when it is no link). A dangling
+// link resolves to the missing file it names, which the rename then creates.
+std::filesystem::path followLinks(const std::filesystem::path& path) {
+  std::filesystem::path target = path;
+  for (int hops = 0; hops < 40; ++hops) {
+    struct stat st {};
+    if (::lstat(target.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return target;
+    std::string link(static_cast<std::size_t>(st.st_size > 0 ? st.st_size : 4096) + 1, '\0');
+    const ssize_t n = ::readlink(target.c_str(), link.data(), link.size());
+    if (n < 0) fail(path, "readlink", errno);
+    link.resize(static_cast<std::size_t>(n));
+    const std::filesystem::path next(link);
+    target = next.is_absolute() ? next : target.parent_path() / next;
+  }
+  fail(path, "resolving its symbolic links", ELOOP);
+}
+
+}  // namespace
+
+void writeFileAtomically(const std::filesystem::path& path, std::string_view contents) {
+  struct stat existing {};
+  const bool exists = ::stat(path.c_str(), &existing) == 0;  // follows links
+  if (!exists && errno != ENOENT) fail(path, "stat", errno);
+  if (exists && S_ISDIR(existing.st_mode)) fail(path, "the target", EISDIR);
+  if (exists && !S_ISREG(existing.st_mode)) {
+    writeInPlace(path, contents);
+    return;
+  }
+  const std::filesystem::path target = followLinks(path);
+
+  TempFile tmp(target.string() + ".tmp.XXXXXX");
+  if (tmp.fd() < 0) fail(path, "cannot create a temporary file beside it", errno);
+  if (exists) {
+    if (::fchmod(tmp.fd(), existing.st_mode & 07777) != 0) fail(path, "fchmod", errno);
+    if (::geteuid() == 0 && ::fchown(tmp.fd(), existing.st_uid, existing.st_gid) != 0) {
+      fail(path, "fchown", errno);
+    }
+  } else {
+    const mode_t mask = ::umask(0);
+    ::umask(mask);
+    if (::fchmod(tmp.fd(), 0666 & ~mask) != 0) fail(path, "fchmod", errno);
+  }
+  writeAll(path, tmp.fd(), contents);
   if (::fsync(tmp.fd()) != 0) fail(path, "fsync", errno);
   if (tmp.close() != 0) fail(path, "close", errno);
-  if (::rename(tmp.name().c_str(), path.c_str()) != 0) fail(path, "rename", errno);
+  if (::rename(tmp.name().c_str(), target.c_str()) != 0) fail(path, "rename", errno);
   tmp.commit();
 }
 

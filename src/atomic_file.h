@@ -1,6 +1,16 @@
 // Files are replaced atomically: the contents go to a temporary file in the same directory,
 // which is flushed to disk and renamed over the target. A crash, a full disk or a missing
 // directory leaves any previous file intact.
+//
+// What the target is decides how it is written:
+//   missing             created by the rename, mode 0666 less the umask
+//   a regular file      replaced by the rename, keeping its permission bits (and, as root, its
+//                       owner); other hard links to it keep the previous contents
+//   a symbolic link     followed to the end: the file it names is replaced as above, the link
+//                       stays (a dangling link's target is created)
+//   anything else       a device, FIFO or socket (/dev/null, /dev/stdout to a pipe) is written
+//                       in place, without a rename: never replaced by a regular file
+//   a directory         refused
 #pragma once
 
 #include <filesystem>

@@ -1,5 +1,7 @@
 // jello-sim and jello-create-world as a user runs them: exit codes, messages, files.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -246,6 +248,23 @@ TEST(JelloCreateWorld, RefusesBadValuesAndWritesNothing) {
   EXPECT_EQ(run(create() + " -o " + out.string() + " --plane 0 0 0 1").code, 1);
   EXPECT_FALSE(std::filesystem::exists(out));
   EXPECT_NE(run(create() + " -o /nonexistent/dir/w.w").code, 0);
+}
+
+// #16: --stats /dev/stdout works (the link is followed to the pipe and written in place), and
+// --out to a device leaves the device a device.
+TEST(JelloSim, WritesStatsToDevStdoutAndLeavesADeviceADevice) {
+  const Outcome r = run(sim() + " " + world("jello.w") + " --steps 5 -q --stats /dev/stdout");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "\"steps\": 5")) << r.output;
+
+  test::TempDir dir;
+  const auto node = dir.path() / "null";
+  if (::mknod(node.c_str(), S_IFCHR | 0666, makedev(1, 3)) != 0) {
+    GTEST_SKIP() << "cannot make a device node here (not root)";
+  }
+  const Outcome out = run(sim() + " " + world("jello.w") + " --steps 5 -q --out " + node.string());
+  EXPECT_EQ(out.code, 0) << out.output;
+  EXPECT_TRUE(std::filesystem::is_character_file(node));
 }
 
 }  // namespace

@@ -1,11 +1,19 @@
 // The writer: exact round trips, the original creator's format, extensions, atomic replace.
 #include "src/world_writer.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+#include <unistd.h>
 
+#include <cerrno>
+#include <chrono>
 #include <cstring>
 #include <limits>
 #include <random>
+#include <string>
+#include <thread>
 
 #include "src/atomic_file.h"
 #include "src/scene_builder.h"
@@ -124,6 +132,95 @@ TEST(AtomicFile, KeepsThePreviousFileWhenTheTargetCannotBeReplaced) {
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()),
                           std::filesystem::directory_iterator{}),
             2);  // w.w and blocked/, no temporary left behind
+}
+
+// Special targets (#16): a device, FIFO or pipe is written in place, never replaced by a
+// regular file; a symbolic link is followed and its file replaced; permissions are kept.
+TEST(AtomicFile, WritesIntoAFifoWithoutReplacingIt) {
+  test::TempDir dir;
+  const auto fifo = dir.path() / "fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
+  // The reader never blocks: should the FIFO be replaced, it gives up after 5 s.
+  std::string received;
+  std::thread reader([&] {
+    const int fd = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+    if (fd < 0) return;
+    for (int waited = 0; waited < 500; ++waited) {
+      char buf[64];
+      const ssize_t n = ::read(fd, buf, sizeof buf);
+      if (n > 0) {
+        received.append(buf, static_cast<std::size_t>(n));
+      } else if (n == 0 && !received.empty()) {
+        break;  // the writer wrote and closed
+      } else {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+    }
+    ::close(fd);
+  });
+  writeFileAtomically(fifo, "through the fifo");
+  reader.join();
+  EXPECT_EQ(received, "through the fifo");
+  EXPECT_TRUE(std::filesystem::is_fifo(fifo));
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()),
+                          std::filesystem::directory_iterator{}),
+            1);
+}
+
+TEST(AtomicFile, WritesIntoAPipeNamedLikeDevStdout) {
+  test::TempDir dir;
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const auto link = dir.path() / "stdout";  // as /dev/stdout -> /proc/self/fd/1
+  std::filesystem::create_symlink("/proc/self/fd/" + std::to_string(fds[1]), link);
+  writeFileAtomically(link, "to the pipe");
+  ::close(fds[1]);
+  char buf[64] = {};
+  const ssize_t n = ::read(fds[0], buf, sizeof buf);
+  ::close(fds[0]);
+  EXPECT_EQ(std::string(buf, n > 0 ? static_cast<std::size_t>(n) : 0), "to the pipe");
+  EXPECT_TRUE(std::filesystem::is_symlink(link));
+}
+
+TEST(AtomicFile, WritesIntoADeviceNodeWithoutReplacingIt) {
+  test::TempDir dir;
+  const auto node = dir.path() / "null";  // a private /dev/null: major 1, minor 3
+  if (::mknod(node.c_str(), S_IFCHR | 0666, makedev(1, 3)) != 0) {
+    GTEST_SKIP() << "cannot make a device node here (" << std::strerror(errno) << ")";
+  }
+  writeFileAtomically(node, "discarded");
+  EXPECT_TRUE(std::filesystem::is_character_file(node));
+}
+
+TEST(AtomicFile, ReplacesTheFileASymlinkNamesAndKeepsTheLink) {
+  test::TempDir dir;
+  const auto file = dir.path() / "real.w";
+  const auto link = dir.path() / "link.w";
+  writeFileAtomically(file, "old");
+  std::filesystem::create_symlink("real.w", link);  // relative, as users make them
+  writeFileAtomically(link, "new");
+  EXPECT_TRUE(std::filesystem::is_symlink(link));
+  EXPECT_EQ(test::readFile(file), "new");
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()),
+                          std::filesystem::directory_iterator{}),
+            2);
+}
+
+TEST(AtomicFile, KeepsTheReplacedFilesPermissions) {
+  test::TempDir dir;
+  const auto path = dir.path() / "private.w";
+  writeFileAtomically(path, "old");
+  ASSERT_EQ(::chmod(path.c_str(), 0640), 0);
+  writeFileAtomically(path, "new");
+  struct stat st {};
+  ASSERT_EQ(::stat(path.c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 07777, 0640u);
+  EXPECT_EQ(test::readFile(path), "new");
+}
+
+TEST(AtomicFile, RefusesADirectory) {
+  test::TempDir dir;
+  EXPECT_THROW(writeFileAtomically(dir.path(), "x"), std::runtime_error);
 }
 
 }  // namespace
