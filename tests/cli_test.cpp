@@ -251,13 +251,18 @@ TEST(JelloCreateWorld, RefusesBadValuesAndWritesNothing) {
 }
 
 // #16: --stats /dev/stdout works (the link is followed to the pipe and written in place), and
-// --out to a device leaves the device a device.
+// --out to a device leaves the device a device. Private stand-ins, never the machine's own
+// /dev/stdout or /dev/null: a writer that regressed would replace them.
 TEST(JelloSim, WritesStatsToDevStdoutAndLeavesADeviceADevice) {
-  const Outcome r = run(sim() + " " + world("jello.w") + " --steps 5 -q --stats /dev/stdout");
+  test::TempDir dir;
+  const auto stdoutLink = dir.path() / "stdout";
+  std::filesystem::create_symlink("/proc/self/fd/1", stdoutLink);  // as /dev/stdout is
+  const Outcome r =
+      run(sim() + " " + world("jello.w") + " --steps 5 -q --stats " + stdoutLink.string());
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_TRUE(contains(r.output, "\"steps\": 5")) << r.output;
+  EXPECT_TRUE(std::filesystem::is_symlink(stdoutLink));
 
-  test::TempDir dir;
   const auto node = dir.path() / "null";
   if (::mknod(node.c_str(), S_IFCHR | 0666, makedev(1, 3)) != 0) {
     GTEST_SKIP() << "cannot make a device node here (not root)";
