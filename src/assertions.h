@@ -14,24 +14,24 @@ namespace jello::detail {
 
 }  // namespace jello::detail
 
+// On: the condition, and a failure report naming it. Off: not evaluated, but still compiled.
+#define JELLO_DETAIL_CHECK(kind, condition, message) \
+  ((condition) ? static_cast<void>(0)                \
+               : ::jello::detail::assertionFailed(kind, #condition, message, __FILE__, __LINE__))
+#define JELLO_DETAIL_UNCHECKED(condition) static_cast<void>(sizeof(!(condition)))
+
 #if defined(JELLO_ENABLE_ASSERTIONS)
 inline constexpr bool kJelloAssertions = true;
-#define JELLO_ASSERT(condition, message) \
-  ((condition)                           \
-       ? static_cast<void>(0)            \
-       : ::jello::detail::assertionFailed("assertion", #condition, message, __FILE__, __LINE__))
+#define JELLO_ASSERT(condition, message) JELLO_DETAIL_CHECK("assertion", condition, message)
 #else
 inline constexpr bool kJelloAssertions = false;
-#define JELLO_ASSERT(condition, message) static_cast<void>(sizeof(!(condition)))
+#define JELLO_ASSERT(condition, message) JELLO_DETAIL_UNCHECKED(condition)
 #endif
 
 #if defined(JELLO_ENABLE_VALIDATION)
 inline constexpr bool kJelloValidate = true;
-#define JELLO_VALIDATE(condition, message) \
-  ((condition)                             \
-       ? static_cast<void>(0)              \
-       : ::jello::detail::assertionFailed("validation", #condition, message, __FILE__, __LINE__))
+#define JELLO_VALIDATE(condition, message) JELLO_DETAIL_CHECK("validation", condition, message)
 #else
 inline constexpr bool kJelloValidate = false;
-#define JELLO_VALIDATE(condition, message) static_cast<void>(sizeof(!(condition)))
+#define JELLO_VALIDATE(condition, message) JELLO_DETAIL_UNCHECKED(condition)
 #endif
