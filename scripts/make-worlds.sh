@@ -18,3 +18,7 @@ $create -o worlds/vortex-spin.w --field vortex --field-resolution 5 --pose rest 
   --velocity 0 0 0 --dt 5e-4
 # The default scene with a 16^3 cube (the cube extension), for cost as N grows.
 $create -o worlds/cube16.w --cube 16 --field-resolution 0 --dt 2.5e-4
+# The spinning, 5% stretched, undamped stiff cube (vibratingStiffCube(1e4)): what the implicit
+# integrators keep of its energy and angular momentum (scripts/integrator-table.py).
+$create -o worlds/spinning-k1e4.w --integrator implicit --k-elastic 1e4 --d-elastic 0 --no-plane \
+  --field-resolution 0 --pose stretched --stretch 1.05 --spin 2 --velocity 0 0 0 --dt 0.01

@@ -76,16 +76,16 @@ CvodeIntegrator::~CvodeIntegrator() {
 }
 
 bool CvodeIntegrator::continues(const Model& model, const State& s) const {
-  if (restartPending_ || !cvode_ || model_ != &model || n3_ != 3 * model.numPoints() || s.t != t_)
-    return false;
+  if (restartPending_ || !cvode_ || modelId_ != model.id() || s.t != t_) return false;
   const double* y = N_VGetArrayPointer(y_.get());
   const std::size_t bytes = static_cast<std::size_t>(n3_) * sizeof(double);
   return std::memcmp(y, s.x.data(), bytes) == 0 && std::memcmp(y + n3_, s.v.data(), bytes) == 0;
 }
 
 StepResult CvodeIntegrator::start(const Model& model, const State& s) {
-  const bool sameModel = cvode_ && model_ == &model && n3_ == 3 * model.numPoints();
+  const bool sameModel = cvode_ && modelId_ == model.id();
   model_ = &model;
+  modelId_ = model.id();
   n3_ = 3 * model.numPoints();
   if (!sameModel) {
     cvode_.reset();

@@ -40,8 +40,9 @@ class CvodeIntegrator final : public Integrator {
   bool continues(const Model& model, const State& state) const;
 
   CvodeOptions options_;
-  const Model* model_ = nullptr;
-  int n3_ = 0;  // 3n
+  const Model* model_ = nullptr;  // for the callbacks, during a step
+  long modelId_ = -1;             // the model bound to (Model::id, never its address)
+  int n3_ = 0;                    // 3n
   sundials::Context context_;
   sundials::Vector y_;
   sundials::Matrix matrix_;

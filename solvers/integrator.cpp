@@ -1,8 +1,9 @@
 #include "solvers/integrator.h"
 
-#include "solvers/backward_euler.h"
 #include "solvers/cvode_integrator.h"
 #include "solvers/explicit_integrators.h"
+#include "solvers/linearized_backward_euler.h"
+#include "solvers/newton_integrators.h"
 
 namespace jello {
 

@@ -75,6 +75,11 @@ SpdSolver::SpdSolver(LinearSolverKind kind, double cgTolerance)
 
 SpdSolver::~SpdSolver() = default;
 
+void SpdSolver::forgetPattern() {
+  impl_->lltAnalyzed = false;
+  impl_->ldltAnalyzed = false;
+}
+
 StepResult SpdSolver::factorize(const SparseMatrix& A) {
   const auto start = Clock::now();
   Impl& s = *impl_;

@@ -42,8 +42,10 @@ class SpdSolver {
   SpdSolver(const SpdSolver&) = delete;
   SpdSolver& operator=(const SpdSolver&) = delete;
 
-  // Prepares to solve with A; every A passed must have the same pattern.
+  // Prepares to solve with A; every A passed must have the same pattern until forgetPattern().
   StepResult factorize(const SparseMatrix& A);
+  // The next factorize analyzes its matrix's pattern afresh (a new model).
+  void forgetPattern();
   // x: on entry the initial guess (cg), on return the solution.
   StepResult solve(const Eigen::VectorXd& b, Eigen::VectorXd& x);
 

@@ -1,36 +1,37 @@
-#include "solvers/backward_euler.h"
+#include "solvers/linearized_backward_euler.h"
 
 #include <algorithm>
 #include <chrono>
 
 namespace jello {
 
-BackwardEuler::BackwardEuler(ImplicitOptions options)
+LinearizedBackwardEuler::LinearizedBackwardEuler(ImplicitOptions options)
     : options_(options), solver_(options.linearSolver, options.cgTolerance) {}
 
-void BackwardEuler::prepare(const Model& model) {
-  // The same object with the same size: another model could reuse a freed one's address.
-  if (model_ == &model && dv_.size() == 3 * model.numPoints()) return;
-  model_ = &model;
+void LinearizedBackwardEuler::prepare(const Model& model) {
+  if (model.id() == modelId_) return;
+  modelId_ = model.id();
+  solver_.forgetPattern();
   jacobian_ = std::make_unique<JacobianAssembler>(model);
   A_ = jacobian_->pattern();
   dv_.setZero(3 * model.numPoints());
 }
 
-void BackwardEuler::assemble(const double* x, const double* v) {
+void LinearizedBackwardEuler::assemble(const double* x, const double* v) {
   const auto start = std::chrono::steady_clock::now();
   jacobian_->assemble(x, v, {options_.clampCompression, false});
   assembleSeconds_ +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-StepResult BackwardEuler::factorAndSolve(double h, const Eigen::VectorXd& rhs, Eigen::VectorXd& x) {
+StepResult LinearizedBackwardEuler::factorAndSolve(double h, const Eigen::VectorXd& rhs,
+                                                   Eigen::VectorXd& x) {
   jacobian_->combine(h, h * h, A_);
   if (StepResult r = solver_.factorize(A_); !r.ok) return r;
   return solver_.solve(rhs, x);
 }
 
-double BackwardEuler::residual(const Model& model, const State& s, double h) {
+double LinearizedBackwardEuler::residual(const Model& model, const State& s, double h) {
   model.forces(x1_, v1_, f_);
   g_ = model.mass() * (v1_ - s.v);  // the momentum change, then minus the impulse
   const double scale = g_.norm() + h * f_.norm();
@@ -38,7 +39,7 @@ double BackwardEuler::residual(const Model& model, const State& s, double h) {
   return scale > 0.0 ? g_.norm() / scale : 0.0;
 }
 
-StepResult BackwardEuler::step(const Model& model, State& s, double h) {
+StepResult LinearizedBackwardEuler::step(const Model& model, State& s, double h) {
   prepare(model);
   model.forces(s.x, s.v, f_);
   // First iteration, linearized at (x0, v0): rhs = h (f0 + h K v0).
@@ -52,13 +53,10 @@ StepResult BackwardEuler::step(const Model& model, State& s, double h) {
 
   int iterations = 1;
   lastResidual_ = 0.0;
-  int maxIterations = options_.newtonIterations;
-  double tolerance = options_.newtonTolerance;
+  int maxIterations = 1;
+  const double tolerance = options_.contactNewtonTolerance;
   if (model.contactBegins(s.x.data(), x1_.data())) {
-    if (options_.contactNewtonIterations > maxIterations) {
-      maxIterations = options_.contactNewtonIterations;
-      tolerance = std::max(tolerance, options_.contactNewtonTolerance);
-    }
+    maxIterations = options_.contactNewtonIterations;
     ++contactSteps_;
   }
   if (maxIterations > 1) {
@@ -88,7 +86,7 @@ StepResult BackwardEuler::step(const Model& model, State& s, double h) {
   return StepResult::success();
 }
 
-std::vector<Statistic> BackwardEuler::statistics() const {
+std::vector<Statistic> LinearizedBackwardEuler::statistics() const {
   const LinearSolverStats& ls = solver_.stats();
   std::vector<Statistic> stats{
       {"newton_iterations", static_cast<double>(newtonIterations_)},

@@ -1,15 +1,19 @@
-// Backward Euler, linearized (Baraff & Witkin 1998), K = df/dx and D = df/dv at (x0, v0):
+// implicit-linear: backward Euler linearized (Baraff & Witkin 1998), K = df/dx and D = df/dv
+// at (x0, v0):
 //   (M - h D - h^2 K) dv = h (f0 + h K v0),   v1 = v0 + dv,   x1 = x0 + h v1.
-// This is the first Newton iteration of backward Euler; with newtonIterations > 1 further
-// iterations solve the exact step, the residual
-//   g(v1) = M (v1 - v0) - h f(x0 + h v1, v1)
-// driven below newtonTolerance relative to |M (v1 - v0)| + |h f|. It never blows up on a
-// linear system and removes energy: an undamped mode keeps 1/(1 + h^2 w^2) of it per step.
+// This is the first Newton iteration of backward Euler, kept so the cost and the error of
+// linearization can be measured against the converged step (`implicit`,
+// solvers/newton_integrators.h). On a linear system it is exact: it never blows up there and an
+// undamped mode keeps 1/(1 + h^2 w^2) of its energy per step. On a stretched, spinning cube it
+// is not: the transverse stiffness k (1 - L0/l) of stretched springs pins the rotation when
+// h^2 k (1 - L0/l)/m >> 1 (src/PHYSICS.md).
 // A step in which a contact begins (a point reaches a wall, the plane or the sphere that it was
 // clear of at the step's start) is Newton-iterated too (up to contactNewtonIterations): the
 // linearized step does not know the penalty spring, lets the point in deep, and stores a large
 // spurious contact energy (measured: 700x the total energy for a cube thrown at 20 m/s into a
-// wall with kCollision = 10^5 at h = 0.01).
+// wall with kCollision = 10^5 at h = 0.01). The Newton iterations drive the residual
+//   g(v1) = M (v1 - v0) - h f(x0 + h v1, v1)
+// below contactNewtonTolerance relative to |M (v1 - v0)| + |h f|.
 // The force field is treated explicitly (its gradient is not symmetric).
 #pragma once
 
@@ -21,12 +25,13 @@
 
 namespace jello {
 
-class BackwardEuler final : public Integrator {
+class LinearizedBackwardEuler final : public Integrator {
  public:
-  explicit BackwardEuler(ImplicitOptions options = {});
-  explicit BackwardEuler(const SolverOptions& options) : BackwardEuler(options.implicit) {}
+  explicit LinearizedBackwardEuler(ImplicitOptions options = {});
+  explicit LinearizedBackwardEuler(const SolverOptions& options)
+      : LinearizedBackwardEuler(options.implicit) {}
 
-  IntegratorKind kind() const override { return IntegratorKind::Implicit; }
+  IntegratorKind kind() const override { return IntegratorKind::ImplicitLinear; }
   StepResult step(const Model& model, State& state, double h) override;
   std::vector<Statistic> statistics() const override;
 
@@ -45,7 +50,7 @@ class BackwardEuler final : public Integrator {
   StepResult factorAndSolve(double h, const Eigen::VectorXd& rhs, Eigen::VectorXd& x);
 
   ImplicitOptions options_;
-  const Model* model_ = nullptr;
+  long modelId_ = -1;
   std::unique_ptr<JacobianAssembler> jacobian_;
   SparseMatrix A_;
   SpdSolver solver_;

@@ -7,15 +7,18 @@ namespace jello {
 
 struct ImplicitOptions {
   LinearSolverKind linearSolver = LinearSolverKind::Cholmod;
-  int newtonIterations = 1;  // 1: the linearized step of Baraff & Witkin
-  // A step during which a contact begins is not near its linearization (the penalty spring
-  // was not in the matrix): it gets up to this many Newton iterations whatever the above.
+  // The converged integrators (implicit, midpoint, newmark, bdf2; solvers/newton_integrators.h).
+  int newtonMaxIterations = 30;           // a step still unconverged then is counted, reported
+  double newtonTolerance = 1e-8;          // relative residual that ends the iterations
+  double newtonPositionTolerance = 1e-8;  // m: a full Newton update this small ends them too
+  int lineSearchMaxCuts = 30;             // halvings of the Newton update per iteration
+  // implicit-linear (one solve per step): a step during which a contact begins is not near its
+  // linearization (the penalty spring was not in the matrix), so it gets up to this many
+  // Newton iterations, to this relative residual: the penalty must act, that's all.
   int contactNewtonIterations = 4;
-  double contactNewtonTolerance =
-      1e-4;                       // their relative residual: the penalty must act, that's all
-  double newtonTolerance = 1e-8;  // relative residual that ends the Newton iterations
-  bool clampCompression = true;   // project each spring's Hessian onto semidefinite matrices
-  double cgTolerance = 1e-6;      // relative residual of the CG solves
+  double contactNewtonTolerance = 1e-4;
+  bool clampCompression = true;  // project each spring's Hessian onto semidefinite matrices
+  double cgTolerance = 1e-6;     // relative residual of the CG solves
 };
 
 struct CvodeOptions {

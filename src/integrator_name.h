@@ -14,14 +14,21 @@ namespace jello {
 // Each row: enumerator, canonical name (lowercase; accepted in any case), the spelling written
 // to world files (the original course files say "Euler" and "RK4"), the class in solvers/ that
 // implements it (constructed from SolverOptions), and a one-line summary.
-#define JELLO_INTEGRATORS(X)                                                             \
-  X(Euler, "euler", "Euler", ExplicitEuler, "explicit (forward) Euler, as the original") \
-  X(Symplectic, "symplectic", "symplectic", SymplecticEuler,                             \
-    "semi-implicit Euler: v from the old state, then x from the new v")                  \
-  X(RK4, "rk4", "RK4", RungeKutta4, "classical fourth-order Runge-Kutta")                \
-  X(Implicit, "implicit", "implicit", BackwardEuler,                                     \
-    "backward Euler through the sparse spring Jacobian (Baraff & Witkin)")               \
-  X(Cvode, "cvode", "cvode", CvodeIntegrator, "SUNDIALS CVODE, variable-order stiff BDF")
+#define JELLO_INTEGRATORS(X)                                                              \
+  X(Euler, "euler", "Euler", ExplicitEuler, "explicit (forward) Euler, as the original")  \
+  X(Symplectic, "symplectic", "symplectic", SymplecticEuler,                              \
+    "semi-implicit Euler: v from the old state, then x from the new v")                   \
+  X(RK4, "rk4", "RK4", RungeKutta4, "classical fourth-order Runge-Kutta")                 \
+  X(Implicit, "implicit", "implicit", BackwardEuler,                                      \
+    "backward Euler solved to convergence (Newton with line search)")                     \
+  X(Cvode, "cvode", "cvode", CvodeIntegrator, "SUNDIALS CVODE, variable-order stiff BDF") \
+  X(ImplicitLinear, "implicit-linear", "implicit-linear", LinearizedBackwardEuler,        \
+    "backward Euler linearized: one linear solve per step (Baraff & Witkin)")             \
+  X(Midpoint, "midpoint", "midpoint", ImplicitMidpoint,                                   \
+    "implicit midpoint: symplectic, second order, no artificial damping")                 \
+  X(Newmark, "newmark", "newmark", Newmark,                                               \
+    "average-acceleration Newmark (trapezoidal rule): second order, A-stable")            \
+  X(Bdf2, "bdf2", "bdf2", Bdf2, "second-order BDF, started by backward Euler")
 
 enum class IntegratorKind {
 #define JELLO_INTEGRATOR_ENUMERATOR(kind, name, fileName, Class, summary) kind,

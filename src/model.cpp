@@ -20,8 +20,15 @@ ModelSpec modelSpecFromWorld(const World& world) {
   return spec;
 }
 
+namespace {
+std::atomic<long> nextModelId{0};
+}  // namespace
+
 Model::Model(ModelSpec spec)
-    : n_(spec.numPoints), mass_(spec.mass), springs_(std::move(spec.springs), spec.numPoints) {
+    : id_(nextModelId.fetch_add(1, std::memory_order_relaxed)),
+      n_(spec.numPoints),
+      mass_(spec.mass),
+      springs_(std::move(spec.springs), spec.numPoints) {
   JELLO_ASSERT(n_ > 0 && mass_ > 0.0, "a model has points of positive mass");
   if (spec.walls) walls_.emplace(spec.contact);
   if (spec.plane) plane_.emplace(*spec.plane, spec.contact);
@@ -123,6 +130,36 @@ double Model::fieldWork(const double* x0, const double* x1) const {
     work += 0.5 * dot(field_->sample(a) + field_->sample(b), b - a);
   }
   return work;
+}
+
+Vec3 Model::momentum(const State& s) const {
+  const int n = n_;
+  return Vec3{s.v.head(n).sum(), s.v.segment(n, n).sum(), s.v.tail(n).sum()} * mass_;
+}
+
+Vec3 Model::angularMomentum(const State& s) const {
+  const int n = n_;
+  const Vec3 c{s.x.head(n).mean(), s.x.segment(n, n).mean(), s.x.tail(n).mean()};
+  Vec3 L;
+  for (int p = 0; p < n; ++p) {
+    const Vec3 r = s.position(p) - c, v = s.velocity(p);
+    L = L + Vec3{r.y * v.z - r.z * v.y, r.z * v.x - r.x * v.z, r.x * v.y - r.y * v.x};
+  }
+  return L * mass_;
+}
+
+double Model::potentialEnergy(const double* x) const {
+  double e = springs_.energy(x);
+  if (walls_) e += walls_->energy(x, n_);
+  if (plane_) e += plane_->energy(x, n_);
+  if (sphere_) e += sphere_->energy(x, n_);
+  return e;
+}
+
+void Model::externalForces(const double* x, Eigen::VectorXd& f) const {
+  f.setZero(3 * n_);
+  if (field_) field_->accumulate(x, f.data(), n_);
+  if (userForce_) f += *userForce_;
 }
 
 Energy Model::energy(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const {

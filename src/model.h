@@ -59,6 +59,9 @@ class Model {
   explicit Model(const World& world) : Model(modelSpecFromWorld(world)) {}
 
   int numPoints() const { return n_; }
+  // Unique to this model among all models built in the process (moves carry it along):
+  // integrators bind to a model by it, never by its address, which a new model may reuse.
+  long id() const { return id_; }
   double mass() const { return mass_; }
 
   // f = total force (N) at state (x, v); all arrays 3n, component-major. The model keeps no
@@ -81,6 +84,14 @@ class Model {
   double fieldWork(const double* x0, const double* x1) const;
 
   Energy energy(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const;
+  // Linear momentum (kg m/s) and angular momentum about the centre of mass (kg m^2/s).
+  Vec3 momentum(const State& s) const;
+  Vec3 angularMomentum(const State& s) const;
+  // Spring plus contact energy (J) at positions x (3n): the potential of the elastic forces.
+  double potentialEnergy(const double* x) const;
+  // The forces no potential above describes, f resized to 3n (N): the field and the user force
+  // at positions x. Zero when the scene has neither.
+  void externalForces(const double* x, Eigen::VectorXd& f) const;
   Energy energy(const State& s) const { return energy(s.x, s.v); }
 
   const SpringForces& springs() const { return springs_; }
@@ -103,6 +114,7 @@ class Model {
   bool hasUserForce() const { return userForce_.has_value(); }
 
  private:
+  long id_;
   int n_;
   double mass_;
   SpringForces springs_;

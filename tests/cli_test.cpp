@@ -94,8 +94,29 @@ TEST(JelloSim, ImplicitIntegratorsRunTheStiffSceneThatExplicitOnesCannot) {
   EXPECT_TRUE(contains(r.output, "factorizations")) << r.output;
   const auto json = nlohmann::json::parse(test::readFile(stats));
   EXPECT_EQ(json["integrator"], "implicit");
-  EXPECT_EQ(json["solver"]["factorizations"], 10);
+  // Converged: one factorization per Newton iteration, several per step, none left unconverged.
+  EXPECT_EQ(json["solver"]["factorizations"], json["solver"]["newton_iterations"]);
+  EXPECT_GT(json["solver"]["factorizations"].get<double>(), 10.0);
+  EXPECT_EQ(json["solver"]["newton_unconverged_steps"], 0);
   EXPECT_GT(json["solver"]["compression_clamps"].get<double>(), 0.0);
+  EXPECT_EQ(json["angular_momentum_end_kg_m2_per_s"].size(), 3u);
+
+  // The linearized step factors once per step.
+  ASSERT_EQ(run(sim() + " " + stiff.string() + " --integrator implicit-linear --dt 0.01" +
+                " --time 0.1 -q --stats " + stats.string())
+                .code,
+            0);
+  EXPECT_EQ(nlohmann::json::parse(test::readFile(stats))["solver"]["factorizations"], 10);
+
+  // A Newton cap too low to converge: the run goes on, counts and says so.
+  const Outcome capped = run(sim() + " " + stiff.string() +
+                             " --integrator midpoint --dt 0.01 --time 0.05 -q --newton-iters 1 "
+                             "--newton-tol 1e-14 --stats " +
+                             stats.string());
+  ASSERT_EQ(capped.code, 0) << capped.output;
+  EXPECT_TRUE(contains(capped.output, "did not converge within 1 Newton iterations"))
+      << capped.output;
+  EXPECT_EQ(nlohmann::json::parse(test::readFile(stats))["solver"]["newton_unconverged_steps"], 5);
 
   const Outcome c = run(sim() + " " + stiff.string() +
                         " --integrator cvode --dt 0.01 --time 0.02 --rtol 1e-3 --max-order 2"

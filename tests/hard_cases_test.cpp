@@ -1,10 +1,12 @@
-// Hard, stiff cases stay numerically stable under the implicit integrators (each case its own
-// test): run 2 simulated seconds with no non-finite value, no point more than 0.5 m beyond a
-// wall, and total energy (kinetic + spring + contact) never above 1.05 times its start plus the
-// work done by the field. The explicit integrators at the same step are reported as diverged.
+// Hard, stiff cases stay numerically stable under every implicit integrator and cvode (each case
+// its own test): run 2 simulated seconds with no non-finite value, no point more than 5 cm inside
+// a wall, the plane or the sphere, and total energy (kinetic + spring + contact) never above
+// 1.05 times its start plus the work done by the field. The explicit integrators at the same
+// step are reported as diverged.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "solvers/simulation.h"
 #include "src/scene_builder.h"
@@ -35,7 +37,10 @@ World thrownIntoAWall() {
 
 World crushedAgainstThePlane() {
   // jello.w's plane -x + y + z + 2 = 0, and a uniform push of 2 N per point (100 g) into it.
+  // kCollision 1e4 (jello.w: 400), so the penalty springs hold the 8.7 m/s impact within a few
+  // centimetres physically: at 400 every integrator lets the corner 13-15 cm in, as it should.
   SceneSpec spec;
+  spec.kCollision = 1e4;
   spec.pose = PosePreset::Rest;
   spec.velocity = {5.0, -5.0, -5.0};
   spec.fieldResolution = 2;
@@ -75,6 +80,22 @@ double fieldWork(const World& w, const State& start, const State& now) {
   return work;
 }
 
+// How far the deepest point is inside a wall, the plane or the sphere (m).
+double deepestPenetration(const Model& model, const State& s) {
+  double deepest = s.x.cwiseAbs().maxCoeff() - kBoxHalfSize;
+  for (int p = 0; p < s.numPoints(); ++p) {
+    const Vec3 x = s.position(p);
+    if (model.plane()) {
+      deepest = std::max(deepest, -(dot(model.plane()->normal(), x) + model.plane()->offset()));
+    }
+    if (model.sphere()) {
+      const Sphere& sphere = model.sphere()->sphere();
+      deepest = std::max(deepest, sphere.radius - norm(x - sphere.center));
+    }
+  }
+  return deepest;
+}
+
 void expectStableForTwoSeconds(const HardCase& c, IntegratorKind kind, SolverOptions options) {
   Simulation sim(c.world, kind, c.dt, options);
   const State start = sim.state();
@@ -86,12 +107,12 @@ void expectStableForTwoSeconds(const HardCase& c, IntegratorKind kind, SolverOpt
     ASSERT_TRUE(r.ok) << r.message;
     const State& s = sim.state();
     ASSERT_TRUE(s.x.allFinite() && s.v.allFinite());
-    deepest = std::max(deepest, s.x.cwiseAbs().maxCoeff() - 2.0);
+    deepest = std::max(deepest, deepestPenetration(sim.model(), s));
     const double budget = e0 + fieldWork(c.world, start, s);
     worstRatio = std::max(worstRatio, sim.model().energy(s).total() / budget);
   }
   EXPECT_NEAR(sim.state().t, 2.0, 1e-9);
-  EXPECT_LE(deepest, 0.5) << "m beyond a wall";
+  EXPECT_LE(deepest, 0.05) << "m inside a wall, the plane or the sphere";
   EXPECT_LE(worstRatio, 1.05) << "energy over its budget";
 }
 
@@ -99,6 +120,14 @@ class HardCaseTest : public ::testing::TestWithParam<HardCase> {};
 
 TEST_P(HardCaseTest, ImplicitStaysStable) {
   expectStableForTwoSeconds(GetParam(), IntegratorKind::Implicit, {});
+}
+
+TEST_P(HardCaseTest, ImplicitLinearStaysStable) {
+  expectStableForTwoSeconds(GetParam(), IntegratorKind::ImplicitLinear, {});
+}
+
+TEST_P(HardCaseTest, Bdf2StaysStable) {
+  expectStableForTwoSeconds(GetParam(), IntegratorKind::Bdf2, {});
 }
 
 TEST_P(HardCaseTest, CvodeStaysStable) {
@@ -110,6 +139,40 @@ TEST_P(HardCaseTest, CvodeStaysStable) {
 
 INSTANTIATE_TEST_SUITE_P(Named, HardCaseTest, ::testing::ValuesIn(hardCases()),
                          [](const auto& param_info) { return param_info.param.name; });
+
+// Midpoint and the trapezoidal rule (newmark) add no artificial damping, and on these violently
+// nonlinear stiff cases (a spring strained 100%, h w_max up to 1,000) that is their undoing:
+// neither conserves energy for nonlinear springs, and both gained 1.5x to 58,000x of it in 2 s
+// (measured, README). What they must still do is stay finite: a run ends, diverged or not,
+// with every state it kept finite. The largest energy ratio and penetration are printed.
+class HardCaseUndamped : public ::testing::TestWithParam<std::tuple<int, IntegratorKind>> {};
+
+TEST_P(HardCaseUndamped, NeverLeavesANonFiniteState) {
+  const auto [index, kind] = GetParam();
+  const HardCase c = hardCases()[static_cast<std::size_t>(index)];
+  Simulation sim(c.world, kind, c.dt);
+  const double e0 = sim.model().energy(sim.state()).total();
+  double worst = 0.0, deepest = 0.0;
+  const long steps = std::lround(0.5 / c.dt);
+  for (long i = 0; i < steps && sim.step().ok; ++i) {
+    ASSERT_TRUE(sim.state().x.allFinite() && sim.state().v.allFinite());
+    worst = std::max(worst, sim.model().energy(sim.state()).total() / e0);
+    deepest = std::max(deepest, deepestPenetration(sim.model(), sim.state()));
+  }
+  ASSERT_TRUE(sim.state().x.allFinite() && sim.state().v.allFinite());
+  std::printf("%s on %s: largest energy ratio %.3g, deepest %.3g m over %.3g s%s\n",
+              std::string(integratorName(kind)).c_str(), c.name.c_str(), worst, deepest,
+              sim.state().t, sim.divergence() ? " (diverged)" : "");
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    StiffDt005AndThrown, HardCaseUndamped,
+    ::testing::Combine(::testing::Values(1, 3, 4),
+                       ::testing::Values(IntegratorKind::Midpoint, IntegratorKind::Newmark)),
+    [](const auto& param_info) {
+      return std::string(integratorName(std::get<1>(param_info.param))) +
+             hardCases()[static_cast<std::size_t>(std::get<0>(param_info.param))].name;
+    });
 
 class StiffCaseExplicit
     : public ::testing::TestWithParam<std::tuple<double, double, IntegratorKind>> {};

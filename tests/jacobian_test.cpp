@@ -147,6 +147,10 @@ TEST(ContactJacobian, MatchesFiniteDifferencesInsideTheSphere) {
   const Assembled clamped = assemble(model, s, {});
   EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(-clamped.K).eigenvalues().minCoeff(),
             -1e-12);
+  // The damping's v-derivative -dc n n^T, moving obliquely into the sphere.
+  const State moving = at({0.2, -0.1, -0.6}, {0.7, -0.4, -1.1});
+  EXPECT_LT(relativeError(assemble(model, moving, {}).D, finiteDifferences(model, moving, true)),
+            1e-6);
 }
 
 TEST(FieldJacobian, MatchesFiniteDifferencesInsideACell) {

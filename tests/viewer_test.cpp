@@ -288,7 +288,7 @@ TEST(Keys, TimeStepZoomCameraResetAndPullRadius) {
 
 TEST(Keys, TheTableNamesEveryKey) {
   const std::string table = keyTable();
-  for (const char* key : {"ESC", "space", "1-5", "+ -", "[ ]", "s h b", " v ", " p ", " r ", " f ",
+  for (const char* key : {"ESC", "space", "1-9", "+ -", "[ ]", "s h b", " v ", " p ", " r ", " f ",
                           " g ", " e ", "z x", " i ", " . "}) {
     EXPECT_NE(("\n" + table).find(std::string(key).substr(key[0] == ' ')), std::string::npos)
         << key;

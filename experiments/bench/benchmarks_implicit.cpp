@@ -12,9 +12,9 @@
 #include <cmath>
 #include <filesystem>
 
-#include "solvers/backward_euler.h"
 #include "solvers/jacobian.h"
 #include "solvers/linear_solver.h"
+#include "solvers/newton_integrators.h"
 #include "solvers/simulation.h"
 #include "src/scene_builder.h"
 #include "src/world_reader.h"
@@ -117,6 +117,34 @@ BENCHMARK_CAPTURE(BM_ImplicitStep, cg, LinearSolverKind::Cg)
     ->Arg(8)
     ->Arg(16)
     ->Unit(benchmark::kMillisecond);
+
+// One step of every implicit integrator at dt = 0.01, on jello.w and on the spinning,
+// stretched, undamped stiff cube (k = 1e4), resampled to N^3 (range 0: N; 1: 0 jello, 1 cube):
+// the converged ones take several factorizations a step (counter newton_per_step).
+void BM_ImplicitIntegratorStep(benchmark::State& st, IntegratorKind kind) {
+  const int n = static_cast<int>(st.range(0));
+  SceneSpec spinning = vibratingStiffCube(1e4);
+  spinning.dElastic = 0.0;
+  const World w = st.range(1) == 0 ? jelloAt(n) : resampleCube(buildWorld(spinning), n);
+  Simulation sim(w, kind, 0.01);
+  for (auto _ : st) {
+    if (!sim.step().ok) st.SkipWithError("step failed");
+  }
+  for (const Statistic& s : sim.integrator().statistics()) {
+    if (s.name == "newton_iterations_per_step") st.counters["newton_per_step"] = s.value;
+    if (s.name == "newton_unconverged_steps") st.counters["unconverged"] = s.value;
+  }
+}
+#define JELLO_IMPLICIT_STEP_BENCHMARK(name, kind)          \
+  BENCHMARK_CAPTURE(BM_ImplicitIntegratorStep, name, kind) \
+      ->ArgsProduct({{8, 16}, {0, 1}})                     \
+      ->ArgNames({"N", "spinning"})                        \
+      ->Unit(benchmark::kMillisecond)
+JELLO_IMPLICIT_STEP_BENCHMARK(implicit, IntegratorKind::Implicit);
+JELLO_IMPLICIT_STEP_BENCHMARK(implicit_linear, IntegratorKind::ImplicitLinear);
+JELLO_IMPLICIT_STEP_BENCHMARK(midpoint, IntegratorKind::Midpoint);
+JELLO_IMPLICIT_STEP_BENCHMARK(newmark, IntegratorKind::Newmark);
+JELLO_IMPLICIT_STEP_BENCHMARK(bdf2, IntegratorKind::Bdf2);
 
 // Runs `sim` to t = 1 s; false if it diverged.
 bool runOneSecond(Simulation& sim) {

@@ -112,6 +112,7 @@ int run(const Options& opt) {
   }
   const long total = static_cast<long>(wanted);
   const Energy start = sim.model().energy(sim.state());
+  const jello::Vec3 startL = sim.model().angularMomentum(sim.state());
   const std::string name(jello::integratorName(sim.integratorKind()));
 
   Trace trace(!opt.trace.empty());
@@ -138,6 +139,7 @@ int run(const Options& opt) {
   const jello::State& s = sim.state();
   const long done = diverged ? sim.steps() - 1 : sim.steps();
   const Energy end = sim.model().energy(s);
+  const jello::Vec3 endL = sim.model().angularMomentum(s);
   nlohmann::json stats = {
       {"world", opt.world},
       {"integrator", name},
@@ -151,11 +153,21 @@ int run(const Options& opt) {
       {"real_time_factor", wall > 0 ? s.t / wall : 0.0},
       {"energy_start", toJson(start)},
       {"energy_end", toJson(end)},
+      {"angular_momentum_start_kg_m2_per_s", {startL.x, startL.y, startL.z}},
+      {"angular_momentum_end_kg_m2_per_s", {endL.x, endL.y, endL.z}},
       {"diverged", diverged},
       {"interrupted", interrupted != 0},
   };
   const std::vector<jello::Statistic> solverStats = sim.integrator().statistics();
   for (const jello::Statistic& st : solverStats) stats["solver"][st.name] = st.value;
+  for (const jello::Statistic& st : solverStats) {
+    if (st.name == "newton_unconverged_steps" && st.value > 0) {
+      std::fprintf(stderr,
+                   "jello-sim: warning: %.0f of %ld steps did not converge within %d Newton "
+                   "iterations (raise --newton-iters or --newton-tol)\n",
+                   st.value, done, opt.solver.implicit.newtonMaxIterations);
+    }
+  }
   if (interrupted) {
     std::fprintf(stderr, "jello-sim: interrupted (signal %d) at t = %g s, after step %ld of %ld\n",
                  interrupted, s.t, done, total);
@@ -254,7 +266,8 @@ int main(int argc, char** argv) {
 
   auto& implicit = opt.solver.implicit;
   auto& cvode = opt.solver.cvode;
-  const char* implicitGroup = "Implicit solvers (implicit, cvode)";
+  const char* implicitGroup =
+      "Implicit solvers (implicit, midpoint, newmark, bdf2, implicit-linear, cvode)";
   app.add_option("--linear-solver", opt.linearSolver,
                  "cholmod (supernodal LLT), ldlt, or cg (Jacobi-preconditioned, warm-started)")
       ->check(CLI::IsMember({"cholmod", "ldlt", "cg"}))
@@ -267,13 +280,20 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str()
       ->group(implicitGroup);
-  app.add_option("--newton-iters", implicit.newtonIterations,
-                 "implicit: Newton iterations per step (1 = linearized Baraff-Witkin step)")
-      ->check(CLI::Range(1, 100))
+  app.add_option("--newton-iters", implicit.newtonMaxIterations,
+                 "implicit, midpoint, newmark, bdf2: most Newton iterations per step (a step "
+                 "still unconverged is counted and reported)")
+      ->check(CLI::Range(1, 1000))
       ->capture_default_str()
       ->group(implicitGroup);
   app.add_option("--newton-tol", implicit.newtonTolerance,
-                 "implicit: relative residual that ends the Newton iterations")
+                 "implicit, midpoint, newmark, bdf2: relative residual that ends the iterations")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group(implicitGroup);
+  app.add_option("--newton-xtol", implicit.newtonPositionTolerance,
+                 "implicit, midpoint, newmark, bdf2: a Newton update moving no coordinate more "
+                 "than this (m) also ends them")
       ->check(CLI::PositiveNumber)
       ->capture_default_str()
       ->group(implicitGroup);

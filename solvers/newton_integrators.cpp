@@ -1,0 +1,239 @@
+#include "solvers/newton_integrators.h"
+
+#include <chrono>
+#include <cmath>
+
+namespace jello {
+namespace {
+
+// Unknown: the displacement d = y - x0 (small, so no digits are lost to the positions' size).
+ImplicitStepForm backwardEulerForm(const State& s, double h) {
+  ImplicitStepForm f;
+  f.gamma = 1.0;
+  f.theta = 1.0;
+  f.sigma = f.sigmaNew = 1.0 / h;
+  f.x0 = s.x;
+  f.dPred = h * s.v;
+  f.vConst = f.vNewConst = Eigen::VectorXd::Zero(s.v.size());
+  return f;
+}
+
+}  // namespace
+
+NewtonIntegrator::NewtonIntegrator(ImplicitOptions options)
+    : options_(options), solver_(options.linearSolver, options.cgTolerance) {}
+
+void NewtonIntegrator::bind(const Model& model) {
+  if (model.id() == modelId_) return;
+  const bool rebinding = modelId_ >= 0;
+  modelId_ = model.id();
+  if (rebinding) restart();  // history from another model means nothing here
+  jacobian_ = std::make_unique<JacobianAssembler>(model);
+  A_ = jacobian_->pattern();
+  solver_.forgetPattern();
+}
+
+// x_e, v_e, f and the residual r at displacement d.
+void NewtonIntegrator::evaluate(const Model& model, const ImplicitStepForm& form,
+                                const Eigen::VectorXd& d) {
+  xe_ = form.x0 + form.theta * d;
+  ve_ = form.sigma * d + form.vConst;
+  model.forces(xe_, ve_, f_);
+  r_ = (form.gamma * model.mass()) * (d - form.dPred);
+  const double inertia = r_.norm();
+  r_ -= f_;
+  const double scale = inertia + f_.norm();
+  lastResidual_ = scale > 0.0 ? r_.norm() / scale : 0.0;
+}
+
+double NewtonIntegrator::merit(const Model& model, const ImplicitStepForm& form,
+                               const Eigen::VectorXd& d) {
+  trial_ = d - form.dPred;
+  double e = 0.5 * form.gamma * model.mass() * trial_.squaredNorm();  // J: r is in newtons
+  xe_ = form.x0 + form.theta * d;
+  ve_ = form.sigma * d + form.vConst;
+  e += (model.potentialEnergy(xe_.data()) - external_.dot(xe_)) / form.theta;
+  dv_.noalias() = jacobian_->D() * ve_;
+  e += -0.5 * ve_.dot(dv_) / form.sigma;
+  return e;
+}
+
+void NewtonIntegrator::assembleMatrix(const ImplicitStepForm& form, double h) {
+  const auto start = std::chrono::steady_clock::now();
+  jacobian_->assemble(xe_.data(), ve_.data(), {options_.clampCompression, false});
+  assembleSeconds_ +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double scale = h * h / form.gamma;
+  jacobian_->combine(form.sigma * scale, form.theta * scale, A_);
+}
+
+StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
+  bind(model);
+  const ImplicitStepForm form = this->form(model, s, h);
+  // gamma/h^2 is folded into the mass: r = gamma m/h^2 (d - d_pred) - f.
+  ImplicitStepForm scaled = form;
+  scaled.gamma = form.gamma / (h * h);
+  // Newton starts from the inertial guess h v0: d_pred itself holds h^2 a0 terms (newmark,
+  // bdf2), metres away from the answer when a stiff spring is stretched.
+  d_ = h * s.v;
+  int iterations = 0;
+  bool converged = false;
+  for (;;) {
+    evaluate(model, scaled, d_);
+    if (lastResidual_ <= options_.newtonTolerance) {
+      converged = true;
+      break;
+    }
+    if (iterations >= options_.newtonMaxIterations) break;
+    ++iterations;
+    // Newton: (h^2/gamma) J delta = -(h^2/gamma) r. x_e, v_e are those of d_ (evaluate).
+    assembleMatrix(form, h);
+    rhs_ = (-h * h / form.gamma) * r_;
+    delta_.setZero(rhs_.size());
+    if (StepResult res = solver_.factorize(A_); !res.ok) return res;
+    if (StepResult res = solver_.solve(rhs_, delta_); !res.ok) return res;
+    if (!delta_.allFinite()) return StepResult::failure("Newton produced a non-finite update");
+    // An update this small is the answer to within it: the floor that ends the iterations at
+    // rest, where round-off keeps the relative residual from falling.
+    if (delta_.cwiseAbs().maxCoeff() <= options_.newtonPositionTolerance) {
+      d_ += delta_;
+      converged = true;
+      break;
+    }
+
+    // Backtracking line search on E_k (frozen damping directions, field and user force).
+    model.externalForces(xe_.data(), external_);  // field and user force at the iterate
+    const double slope = r_.dot(delta_);
+    double alpha = 1.0;
+    if (slope < 0.0) {
+      const double e0 = merit(model, scaled, d_);
+      // Near the answer the decrease is below E's round-off (E sums the energy of every
+      // spring): there the merit cannot judge, and the full Newton step is taken.
+      const double noise = 1e-12 * std::abs(e0);
+      for (int cut = 0; cut < options_.lineSearchMaxCuts; ++cut) {
+        const double e = merit(model, scaled, d_ + alpha * delta_);
+        if (e <= e0 + 1e-4 * alpha * slope + noise) break;
+        alpha *= 0.5;
+        ++cuts_;
+      }
+    }
+    d_ += alpha * delta_;
+  }
+  lastIterations_ = iterations;
+  lastConverged_ = converged;
+  iterations_ += iterations;
+  maxIterations_ = std::max<long>(maxIterations_, iterations);
+  if (!converged) ++unconverged_;
+  ++steps_;
+
+  const State before = s;
+  s.v = form.sigmaNew * d_ + form.vNewConst;
+  s.x += d_;
+  s.t += h;
+  accepted(before, s, h);
+  return StepResult::success();
+}
+
+Eigen::VectorXd NewtonIntegrator::residual(const Model& model, const State& start, double h,
+                                           const Eigen::VectorXd& y) {
+  bind(model);
+  ImplicitStepForm form = this->form(model, start, h);
+  form.gamma /= h * h;
+  evaluate(model, form, y - start.x);
+  return r_;
+}
+
+SparseMatrix NewtonIntegrator::newtonMatrix(const Model& model, const State& start, double h,
+                                            const Eigen::VectorXd& y) {
+  bind(model);
+  const ImplicitStepForm form = this->form(model, start, h);
+  ImplicitStepForm scaled = form;
+  scaled.gamma /= h * h;
+  evaluate(model, scaled, y - start.x);
+  assembleMatrix(form, h);
+  return A_ * (form.gamma / (h * h));
+}
+
+std::vector<Statistic> NewtonIntegrator::statistics() const {
+  const LinearSolverStats& ls = solver_.stats();
+  std::vector<Statistic> stats{
+      {"newton_iterations", static_cast<double>(iterations_)},
+      {"newton_iterations_per_step", steps_ ? double(iterations_) / double(steps_) : 0.0},
+      {"newton_iterations_max", static_cast<double>(maxIterations_)},
+      {"newton_unconverged_steps", static_cast<double>(unconverged_)},
+      {"line_search_cuts", static_cast<double>(cuts_)},
+      {"compression_clamps", static_cast<double>(jacobian_ ? jacobian_->totalClampCount() : 0)},
+      {"factorizations", static_cast<double>(ls.factorizations)},
+      {"ldlt_fallbacks", static_cast<double>(ls.fallbacks)},
+      {"assemble_time_s", assembleSeconds_},
+      {"factor_time_s", ls.factorSeconds},
+      {"solve_time_s", ls.solveSeconds},
+  };
+  if (options_.linearSolver == LinearSolverKind::Cg) {
+    stats.push_back({"cg_iterations", static_cast<double>(ls.cgIterations)});
+  }
+  return stats;
+}
+
+ImplicitStepForm BackwardEuler::form(const Model&, const State& s, double h) {
+  return backwardEulerForm(s, h);
+}
+
+ImplicitStepForm ImplicitMidpoint::form(const Model&, const State& s, double h) {
+  ImplicitStepForm f;
+  f.gamma = 2.0;
+  f.theta = 0.5;
+  f.sigma = 1.0 / h;
+  f.sigmaNew = 2.0 / h;
+  f.x0 = s.x;
+  f.dPred = h * s.v;
+  f.vConst = Eigen::VectorXd::Zero(s.v.size());
+  f.vNewConst = -s.v;
+  return f;
+}
+
+namespace {
+
+ImplicitStepForm newmarkForm(const Model& model, const State& s, double h, Eigen::VectorXd& a0) {
+  model.acceleration(s.x, s.v, a0);
+  ImplicitStepForm f;
+  f.gamma = 4.0;
+  f.theta = 1.0;
+  f.sigma = f.sigmaNew = 2.0 / h;
+  f.x0 = s.x;
+  f.dPred = h * s.v + (0.25 * h * h) * a0;
+  f.vConst = f.vNewConst = -s.v;
+  return f;
+}
+
+}  // namespace
+
+ImplicitStepForm Newmark::form(const Model& model, const State& s, double h) {
+  return newmarkForm(model, s, h, a0_);
+}
+
+ImplicitStepForm Bdf2::form(const Model&, const State& s, double h) {
+  const bool continues = history_ && h == h_ && s.t == last_.t && s.x == last_.x && s.v == last_.v;
+  if (!continues) {
+    ++startSteps_;
+    return backwardEulerForm(s, h);
+  }
+  const State& p = previous_;  // (x0, v0); s is (x1, v1)
+  ImplicitStepForm f;
+  f.gamma = 9.0 / 4.0;
+  f.theta = 1.0;
+  f.sigma = f.sigmaNew = 3.0 / (2.0 * h);
+  f.x0 = s.x;
+  f.dPred = (s.x - p.x) / 3.0 + (2.0 * h / 9.0) * (4.0 * s.v - p.v);
+  f.vConst = f.vNewConst = (p.x - s.x) / (2.0 * h);
+  return f;
+}
+
+void Bdf2::accepted(const State& before, const State& after, double h) {
+  previous_ = before;
+  last_ = after;
+  h_ = h;
+  history_ = true;
+}
+
+}  // namespace jello

