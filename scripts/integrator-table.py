@@ -1,0 +1,142 @@
+#!/usr/bin/env python3
+"""What each integrator keeps of a spinning, stretched, undamped stiff cube over 1 s.
+
+Runs jello-sim on worlds/spinning-k1e4.w (k = 1e4 N/m, 5% stretched, spinning at 2 rad/s, no
+damping, no contact) under every implicit integrator at dt = 0.01 s, cvode, and RK4 at a stable
+step as the reference, and writes experiments/results/integrators.csv (one row per integrator)
+with a JSON sidecar. With --readme it also rewrites the table in README.md between the markers
+<!-- integrators-table:begin --> and <!-- integrators-table:end --> from that CSV alone.
+
+    scripts/integrator-table.py [--readme] [--bin build/release/bin]
+"""
+import argparse
+import csv
+import datetime
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+WORLD = os.path.join(ROOT, "worlds", "spinning-k1e4.w")
+CSV = os.path.join(ROOT, "experiments", "results", "integrators.csv")
+SIDECAR = os.path.join(ROOT, "experiments", "results", "integrators.json")
+README = os.path.join(ROOT, "README.md")
+BEGIN, END = "<!-- integrators-table:begin -->", "<!-- integrators-table:end -->"
+
+# integrator, dt (s), extra jello-sim arguments
+RUNS = [
+    ("rk4", 1e-4, []),
+    ("implicit", 0.01, []),
+    ("implicit-linear", 0.01, []),
+    ("midpoint", 0.01, []),
+    ("newmark", 0.01, []),
+    ("bdf2", 0.01, []),
+    ("cvode", 0.01, ["--rtol", "1e-6"]),
+]
+COLUMNS = ["integrator", "dt_s", "simulated_s", "steps", "energy_start_J", "energy_end_J",
+           "energy_kept", "angular_momentum_kept", "wall_time_s", "wall_time_per_step_ms",
+           "newton_iterations_per_step", "newton_unconverged_steps", "factorizations", "diverged"]
+
+
+def run(binary, integrator, dt, extra):
+    with tempfile.TemporaryDirectory() as tmp:
+        stats = os.path.join(tmp, "stats.json")
+        cmd = [os.path.join(binary, "jello-sim"), WORLD, "--integrator", integrator, "--dt",
+               repr(dt), "--time", "1", "--quiet", "--stats", stats] + extra
+        print("integrator-table:", " ".join(cmd[1:]), file=sys.stderr)
+        done = subprocess.run(cmd, check=False)
+        if done.returncode not in (0, 3):
+            sys.exit(f"integrator-table: jello-sim exited {done.returncode}")
+        with open(stats) as f:
+            s = json.load(f)
+    l0 = s["angular_momentum_start_kg_m2_per_s"]
+    l1 = s["angular_momentum_end_kg_m2_per_s"]
+    solver = s.get("solver", {})
+    return {
+        "integrator": integrator,
+        "dt_s": dt,
+        "simulated_s": s["simulated_time_s"],
+        "steps": s["steps"],
+        "energy_start_J": s["energy_start"]["total_J"],
+        "energy_end_J": s["energy_end"]["total_J"],
+        "energy_kept": s["energy_end"]["total_J"] / s["energy_start"]["total_J"],
+        "angular_momentum_kept": sum(a * b for a, b in zip(l0, l1)) / sum(a * a for a in l0),
+        "wall_time_s": s["wall_time_s"],
+        "wall_time_per_step_ms": 1e3 * s["wall_time_s"] / max(1, s["steps"]),
+        "newton_iterations_per_step": solver.get("newton_iterations_per_step", ""),
+        "newton_unconverged_steps": solver.get("newton_unconverged_steps", ""),
+        "factorizations": solver.get("factorizations", ""),
+        "diverged": s["diverged"],
+    }
+
+
+def write_atomically(path, text):
+    fd, tmp = tempfile.mkstemp(dir=os.path.dirname(path), prefix=".tmp.")
+    with os.fdopen(fd, "w") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
+def table_from_csv():
+    with open(CSV) as f:
+        rows = list(csv.DictReader(f))
+    lines = ["| integrator | dt (s) | energy kept | angular momentum kept | wall time for 1 s "
+             "| per step | Newton iterations per step |", "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        newton = r["newton_iterations_per_step"]
+        newton = f"{float(newton):.1f}" if newton else "n/a"
+        lines.append(f"| `{r['integrator']}` | {float(r['dt_s']):g} | "
+                     f"{float(r['energy_kept']):.4g} | {float(r['angular_momentum_kept']):.4g} | "
+                     f"{float(r['wall_time_s']):.3g} s | "
+                     f"{float(r['wall_time_per_step_ms']):.3g} ms | {newton} |")
+    return "\n".join(lines)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--bin", default=os.path.join(ROOT, "build", "release", "bin"))
+    parser.add_argument("--readme", action="store_true", help="rewrite README's table only")
+    parser.add_argument("--no-run", action="store_true", help="use the committed CSV")
+    args = parser.parse_args()
+    if not args.no_run:
+        rows = [run(args.bin, *r) for r in RUNS]
+        with tempfile.NamedTemporaryFile("w", newline="", delete=False,
+                                         dir=os.path.dirname(CSV)) as f:
+            writer = csv.DictWriter(f, fieldnames=COLUMNS)
+            writer.writeheader()
+            writer.writerows(rows)
+        os.replace(f.name, CSV)
+        commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "HEAD"], capture_output=True,
+                                text=True).stdout.strip()
+        dirty = bool(subprocess.run(["git", "-C", ROOT, "status", "--porcelain",
+                                     "--untracked-files=no"], capture_output=True,
+                                    text=True).stdout.strip())
+        cpu = "unknown"
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+        sidecar = {"command_line": sys.argv, "world": os.path.relpath(WORLD, ROOT),
+                   "runs": [{"integrator": i, "dt_s": dt, "extra": e} for i, dt, e in RUNS],
+                   "commit": commit, "tree_modified": dirty, "cpu": cpu,
+                   "cores": os.cpu_count(), "kernel": platform.release(),
+                   "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS", ""),
+                   "OMP_THREAD_LIMIT": os.environ.get("OMP_THREAD_LIMIT", ""),
+                   "date_utc": datetime.datetime.utcnow().strftime("%Y-%m-%dT%H:%M:%SZ")}
+        write_atomically(SIDECAR, json.dumps(sidecar, indent=2) + "\n")
+    if args.readme:
+        with open(README) as f:
+            text = f.read()
+        if BEGIN not in text or END not in text:
+            sys.exit("integrator-table: README.md has no table markers")
+        head, rest = text.split(BEGIN, 1)
+        _, tail = rest.split(END, 1)
+        write_atomically(README, head + BEGIN + "\n" + table_from_csv() + "\n" + END + tail)
+
+
+if __name__ == "__main__":
+    main()
