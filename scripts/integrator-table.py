@@ -7,7 +7,13 @@ step as the reference, and writes experiments/results/integrators.csv (one row p
 with a JSON sidecar. With --readme it also rewrites the table in README.md between the markers
 <!-- integrators-table:begin --> and <!-- integrators-table:end --> from that CSV alone.
 
-    scripts/integrator-table.py [--readme] [--bin build/release/bin]
+    scripts/integrator-table.py [--readme] [--no-run] [--bin build/release/bin]
+
+The second README table, the cost of one step of each implicit integrator, comes from
+experiments/results/implicit_steps.json, which Google Benchmark writes:
+    OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 0 build/release/bin/benchmarks \
+      --benchmark_filter=ImplicitIntegratorStep --benchmark_min_time=0.2 \
+      --benchmark_out=experiments/results/implicit_steps.json --benchmark_out_format=json
 """
 import argparse
 import csv
@@ -25,6 +31,9 @@ CSV = os.path.join(ROOT, "experiments", "results", "integrators.csv")
 SIDECAR = os.path.join(ROOT, "experiments", "results", "integrators.json")
 README = os.path.join(ROOT, "README.md")
 BEGIN, END = "<!-- integrators-table:begin -->", "<!-- integrators-table:end -->"
+# Google Benchmark's JSON of BM_ImplicitIntegratorStep (see --steps-json), and its README table.
+STEPS_JSON = os.path.join(ROOT, "experiments", "results", "implicit_steps.json")
+STEPS_BEGIN, STEPS_END = "<!-- implicit-steps:begin -->", "<!-- implicit-steps:end -->"
 
 # integrator, dt (s), extra jello-sim arguments
 RUNS = [
@@ -95,6 +104,40 @@ def table_from_csv():
     return "\n".join(lines)
 
 
+def steps_table_from_json():
+    with open(STEPS_JSON) as f:
+        data = json.load(f)
+    cells = {}
+    order = []
+    for b in data["benchmarks"]:
+        # BM_ImplicitIntegratorStep/<integrator>/N:<n>/spinning:<0|1>
+        _, name, n, spinning = b["name"].split("/")
+        name = name.replace("_", "-")
+        if name not in order:
+            order.append(name)
+        ms = b["real_time"] * {"ms": 1.0, "s": 1e3, "us": 1e-3}[b["time_unit"]]
+        newton = b.get("newton_per_step")
+        cells[(name, n.split(":")[1], spinning.split(":")[1])] = (ms, newton)
+    lines = ["| integrator | jello.w 8^3 | spinning cube 8^3 | jello.w 16^3 | spinning cube 16^3 |",
+             "|---|---|---|---|---|"]
+    for name in order:
+        row = [f"`{name}`"]
+        for n, spinning in (("8", "0"), ("8", "1"), ("16", "0"), ("16", "1")):
+            ms, newton = cells[(name, n, spinning)]
+            text = f"{ms:.3g} ms" if ms < 1000 else f"{ms / 1e3:.3g} s"
+            row.append(text + (f" ({newton:.2g} it.)" if newton is not None else ""))
+        lines.append("| " + " | ".join(row) + " |")
+    return "\n".join(lines)
+
+
+def replace_between(text, begin, end, body):
+    if begin not in text or end not in text:
+        sys.exit(f"integrator-table: README.md has no {begin} marker")
+    head, rest = text.split(begin, 1)
+    _, tail = rest.split(end, 1)
+    return head + begin + "\n" + body + "\n" + end + tail
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--bin", default=os.path.join(ROOT, "build", "release", "bin"))
@@ -131,11 +174,9 @@ def main():
     if args.readme:
         with open(README) as f:
             text = f.read()
-        if BEGIN not in text or END not in text:
-            sys.exit("integrator-table: README.md has no table markers")
-        head, rest = text.split(BEGIN, 1)
-        _, tail = rest.split(END, 1)
-        write_atomically(README, head + BEGIN + "\n" + table_from_csv() + "\n" + END + tail)
+        text = replace_between(text, BEGIN, END, table_from_csv())
+        text = replace_between(text, STEPS_BEGIN, STEPS_END, steps_table_from_json())
+        write_atomically(README, text)
 
 
 if __name__ == "__main__":
