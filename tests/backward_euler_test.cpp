@@ -8,6 +8,7 @@
 #include "solvers/linearized_backward_euler.h"
 #include "solvers/newton_integrators.h"
 #include "src/scene_builder.h"
+#include "tests/newton_test_support.h"
 #include "tests/test_support.h"
 
 namespace jello {
@@ -37,18 +38,8 @@ TEST(LinearizedBackwardEuler, UndampedLinearSpringKeepsOneOverOnePlusH2W2OfItsEn
   expectBackwardEulerEnergyFactor<LinearizedBackwardEuler>();
 }
 
-// A 4^3 free cube (jello.w's pose and motion resampled, no walls, no plane): small systems.
-struct SmallCube {
-  World world = resampleCube(test::loadWorld("jello.w"), 4);
-  Model model{test::freeCube(world)};
-};
-
-Eigen::VectorXd positionsAt(const SmallCube& cube, Integrator& method, double h, double T) {
-  State s = initialState(cube.world);
-  const long steps = std::lround(T / h);
-  for (long i = 0; i < steps; ++i) EXPECT_TRUE(method.step(cube.model, s, h).ok);
-  return s.x;
-}
+using test::positionsAt;
+using test::SmallCube;
 
 TEST(BackwardEuler, ConvergesWithOrderOneTowardRK4) {
   const SmallCube cube;

@@ -21,14 +21,8 @@ namespace {
 
 using test::angularMomentum;
 using test::kConverged;
+using test::positionsAt;
 using test::SmallCube;
-
-Eigen::VectorXd positionsAt(const SmallCube& cube, Integrator& method, double h, double T) {
-  State s = initialState(cube.world);
-  const long steps = std::lround(T / h);
-  for (long i = 0; i < steps; ++i) EXPECT_TRUE(method.step(cube.model, s, h).ok);
-  return s.x;
-}
 
 TEST(NewtonIntegrators, ConvergeWithTheirOrders) {
   const SmallCube cube;

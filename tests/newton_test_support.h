@@ -1,8 +1,11 @@
-// What the converged-integrator tests share: the four methods, a factory over their options,
-// a small free cube, and angular momentum about the centre of mass.
+// What the implicit-integrator tests share: the four converged methods, a factory over their
+// options, a small free cube and a run over it, and angular momentum about the centre of mass.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <Eigen/Geometry>
+#include <cmath>
 #include <memory>
 
 #include "solvers/newton_integrators.h"
@@ -35,6 +38,14 @@ struct SmallCube {
   World world = resampleCube(loadWorld("jello.w"), 4);
   Model model{freeCube(world)};
 };
+
+// The positions after running `method` on the cube for T seconds at step h (each step checked).
+inline Eigen::VectorXd positionsAt(const SmallCube& cube, Integrator& method, double h, double T) {
+  State s = initialState(cube.world);
+  const long steps = std::lround(T / h);
+  for (long i = 0; i < steps; ++i) EXPECT_TRUE(method.step(cube.model, s, h).ok);
+  return s.x;
+}
 
 // About the centre of mass, computed here from the state (an oracle apart from Model's).
 inline Eigen::Vector3d angularMomentum(const Model& model, const State& s) {
