@@ -110,11 +110,24 @@ StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
       // Near the answer the decrease is below E's round-off (E sums the energy of every
       // spring): there the merit cannot judge, and the full Newton step is taken.
       const double noise = 1e-12 * std::abs(e0);
-      for (int cut = 0; cut < options_.lineSearchMaxCuts; ++cut) {
+      bool descended = false;
+      for (int cut = 0; cut <= options_.lineSearchMaxCuts; ++cut) {
         const double e = merit(model, scaled, d_ + alpha * delta_);
-        if (e <= e0 + 1e-4 * alpha * slope + noise) break;
-        alpha *= 0.5;
-        ++cuts_;
+        if (e <= e0 + 1e-4 * alpha * slope + noise) {
+          descended = true;
+          break;
+        }
+        if (cut < options_.lineSearchMaxCuts) {
+          alpha *= 0.5;
+          ++cuts_;
+        }
+      }
+      // No step along delta descends (the unclamped Hessian can be indefinite, and the merit
+      // freezes damping and field): creeping along it would stall Newton, so take the whole
+      // Newton step, as plain Newton does, and count it.
+      if (!descended) {
+        alpha = 1.0;
+        ++searchFailures_;
       }
     }
     d_ += alpha * delta_;
@@ -162,6 +175,7 @@ std::vector<Statistic> NewtonIntegrator::statistics() const {
       {"newton_iterations_max", static_cast<double>(maxIterations_)},
       {"newton_unconverged_steps", static_cast<double>(unconverged_)},
       {"line_search_cuts", static_cast<double>(cuts_)},
+      {"line_search_failures", static_cast<double>(searchFailures_)},
       {"compression_clamps", static_cast<double>(jacobian_ ? jacobian_->totalClampCount() : 0)},
       {"factorizations", static_cast<double>(ls.factorizations)},
       {"ldlt_fallbacks", static_cast<double>(ls.fallbacks)},

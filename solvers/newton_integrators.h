@@ -26,7 +26,8 @@
 // iterate. Its gradient at the iterate is exactly r, so Newton's fixed point is the step's
 // equations with every force where the method evaluates it: damping and the field are not
 // approximated, only frozen inside one iteration's line search. A backtracking (Armijo) line
-// search on E_k makes every iteration descend, from any start.
+// search on E_k makes the iterations descend; where no step of at least 2^-12 of the update
+// descends (an indefinite unclamped Hessian), the whole update is taken and counted.
 // Newton stops when the residual is below newtonTolerance relative to |gamma/h^2 M (y - y_pred)|
 // + |f|, or when a Newton update moves no coordinate more than newtonPositionTolerance (m), the
 // update then taken whole: the absolute floor that ends the iterations at rest, where round-off
@@ -98,7 +99,8 @@ class NewtonIntegrator : public Integrator {
   int lastIterations_ = 0;
   double lastResidual_ = 0.0;
   bool lastConverged_ = true;
-  long steps_ = 0, iterations_ = 0, maxIterations_ = 0, cuts_ = 0, unconverged_ = 0;
+  long steps_ = 0, iterations_ = 0, maxIterations_ = 0, cuts_ = 0, searchFailures_ = 0,
+       unconverged_ = 0;
   double assembleSeconds_ = 0.0;
 };
 

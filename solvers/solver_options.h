@@ -11,7 +11,7 @@ struct ImplicitOptions {
   int newtonMaxIterations = 30;           // a step still unconverged then is counted, reported
   double newtonTolerance = 1e-8;          // relative residual that ends the iterations
   double newtonPositionTolerance = 1e-8;  // m: a full Newton update this small ends them too
-  int lineSearchMaxCuts = 30;             // halvings of the Newton update per iteration
+  int lineSearchMaxCuts = 12;  // halvings of the Newton update; none descends: the whole step
   // implicit-linear (one solve per step): a step during which a contact begins is not near its
   // linearization (the penalty spring was not in the matrix), so it gets up to this many
   // Newton iterations, to this relative residual: the penalty must act, that's all.
