@@ -145,6 +145,12 @@ def main():
     parser.add_argument("--no-run", action="store_true", help="use the committed CSV")
     args = parser.parse_args()
     if not args.no_run:
+        # The tree's state before this run writes its own CSV (which git tracks).
+        commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "HEAD"], capture_output=True,
+                                text=True).stdout.strip()
+        dirty = bool(subprocess.run(["git", "-C", ROOT, "status", "--porcelain",
+                                     "--untracked-files=no"], capture_output=True,
+                                    text=True).stdout.strip())
         rows = [run(args.bin, *r) for r in RUNS]
         with tempfile.NamedTemporaryFile("w", newline="", delete=False,
                                          dir=os.path.dirname(CSV)) as f:
@@ -152,11 +158,6 @@ def main():
             writer.writeheader()
             writer.writerows(rows)
         os.replace(f.name, CSV)
-        commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "HEAD"], capture_output=True,
-                                text=True).stdout.strip()
-        dirty = bool(subprocess.run(["git", "-C", ROOT, "status", "--porcelain",
-                                     "--untracked-files=no"], capture_output=True,
-                                    text=True).stdout.strip())
         cpu = "unknown"
         with open("/proc/cpuinfo") as f:
             for line in f:
