@@ -7,20 +7,20 @@ namespace jello {
 namespace {
 
 // Unknown: the displacement d = y - x0 (small, so no digits are lost to the positions' size).
-ImplicitStepForm backwardEulerForm(const State& s, double h) {
-  ImplicitStepForm f;
+// Forms are filled into the integrator's own, so their vectors are allocated once.
+void backwardEulerForm(const State& s, double h, ImplicitStepForm& f) {
   f.gamma = 1.0;
   f.theta = 1.0;
   f.sigma = f.sigmaNew = 1.0 / h;
   f.x0 = s.x;
   f.dPred = h * s.v;
-  f.vConst = f.vNewConst = Eigen::VectorXd::Zero(s.v.size());
-  return f;
+  f.vConst.setZero(s.v.size());
+  f.vNewConst.setZero(s.v.size());
 }
 
 }  // namespace
 
-NewtonIntegrator::NewtonIntegrator(ImplicitOptions options)
+NewtonIntegrator::NewtonIntegrator(const ImplicitOptions& options)
     : options_(options), solver_(options.linearSolver, options.cgTolerance) {}
 
 void NewtonIntegrator::bind(const Model& model) {
@@ -33,23 +33,23 @@ void NewtonIntegrator::bind(const Model& model) {
   solver_.forgetPattern();
 }
 
-// x_e, v_e, f and the residual r at displacement d.
-void NewtonIntegrator::evaluate(const Model& model, const ImplicitStepForm& form,
-                                const Eigen::VectorXd& d) {
+// x_e, v_e, f and the residual r at displacement d; inertia = gamma/h^2.
+void NewtonIntegrator::evaluate(const Model& model, double inertia, const Eigen::VectorXd& d) {
+  const ImplicitStepForm& form = form_;
   xe_ = form.x0 + form.theta * d;
   ve_ = form.sigma * d + form.vConst;
   model.forces(xe_, ve_, f_);
-  r_ = (form.gamma * model.mass()) * (d - form.dPred);
-  const double inertia = r_.norm();
+  r_ = (inertia * model.mass()) * (d - form.dPred);
+  const double inertiaNorm = r_.norm();
   r_ -= f_;
-  const double scale = inertia + f_.norm();
+  const double scale = inertiaNorm + f_.norm();
   lastResidual_ = scale > 0.0 ? r_.norm() / scale : 0.0;
 }
 
-double NewtonIntegrator::merit(const Model& model, const ImplicitStepForm& form,
-                               const Eigen::VectorXd& d) {
+double NewtonIntegrator::merit(const Model& model, double inertia, const Eigen::VectorXd& d) {
+  const ImplicitStepForm& form = form_;
   trial_ = d - form.dPred;
-  double e = 0.5 * form.gamma * model.mass() * trial_.squaredNorm();  // J: r is in newtons
+  double e = 0.5 * inertia * model.mass() * trial_.squaredNorm();  // J: r is in newtons
   xe_ = form.x0 + form.theta * d;
   ve_ = form.sigma * d + form.vConst;
   e += (model.potentialEnergy(xe_.data()) - external_.dot(xe_)) / form.theta;
@@ -58,7 +58,8 @@ double NewtonIntegrator::merit(const Model& model, const ImplicitStepForm& form,
   return e;
 }
 
-void NewtonIntegrator::assembleMatrix(const ImplicitStepForm& form, double h) {
+void NewtonIntegrator::assembleMatrix(double h) {
+  const ImplicitStepForm& form = form_;
   const auto start = std::chrono::steady_clock::now();
   jacobian_->assemble(xe_.data(), ve_.data(), {options_.clampCompression, false});
   assembleSeconds_ +=
@@ -69,17 +70,16 @@ void NewtonIntegrator::assembleMatrix(const ImplicitStepForm& form, double h) {
 
 StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
   bind(model);
-  const ImplicitStepForm form = this->form(model, s, h);
-  // gamma/h^2 is folded into the mass: r = gamma m/h^2 (d - d_pred) - f.
-  ImplicitStepForm scaled = form;
-  scaled.gamma = form.gamma / (h * h);
+  this->form(model, s, h, form_);
+  const ImplicitStepForm& form = form_;
+  const double inertia = form.gamma / (h * h);  // r = gamma m/h^2 (d - d_pred) - f
   // Newton starts from the inertial guess h v0: d_pred itself holds h^2 a0 terms (newmark,
   // bdf2), metres away from the answer when a stiff spring is stretched.
   d_ = h * s.v;
   int iterations = 0;
   bool converged = false;
   for (;;) {
-    evaluate(model, scaled, d_);
+    evaluate(model, inertia, d_);
     if (lastResidual_ <= options_.newtonTolerance) {
       converged = true;
       break;
@@ -87,7 +87,7 @@ StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
     if (iterations >= options_.newtonMaxIterations) break;
     ++iterations;
     // Newton: (h^2/gamma) J delta = -(h^2/gamma) r. x_e, v_e are those of d_ (evaluate).
-    assembleMatrix(form, h);
+    assembleMatrix(h);
     rhs_ = (-h * h / form.gamma) * r_;
     delta_.setZero(rhs_.size());
     if (StepResult res = solver_.factorize(A_); !res.ok) return res;
@@ -106,13 +106,14 @@ StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
     const double slope = r_.dot(delta_);
     double alpha = 1.0;
     if (slope < 0.0) {
-      const double e0 = merit(model, scaled, d_);
+      const double e0 = merit(model, inertia, d_);
       // Near the answer the decrease is below E's round-off (E sums the energy of every
       // spring): there the merit cannot judge, and the full Newton step is taken.
       const double noise = 1e-12 * std::abs(e0);
       bool descended = false;
       for (int cut = 0; cut <= options_.lineSearchMaxCuts; ++cut) {
-        const double e = merit(model, scaled, d_ + alpha * delta_);
+        dTrial_ = d_ + alpha * delta_;
+        const double e = merit(model, inertia, dTrial_);
         if (e <= e0 + 1e-4 * alpha * slope + noise) {
           descended = true;
           break;
@@ -139,32 +140,28 @@ StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
   if (!converged) ++unconverged_;
   ++steps_;
 
-  const State before = s;
   s.v = form.sigmaNew * d_ + form.vNewConst;
   s.x += d_;
   s.t += h;
-  accepted(before, s, h);
+  accepted(s, h);
   return StepResult::success();
 }
 
 Eigen::VectorXd NewtonIntegrator::residual(const Model& model, const State& start, double h,
                                            const Eigen::VectorXd& y) {
   bind(model);
-  ImplicitStepForm form = this->form(model, start, h);
-  form.gamma /= h * h;
-  evaluate(model, form, y - start.x);
+  form(model, start, h, form_);
+  evaluate(model, form_.gamma / (h * h), y - start.x);
   return r_;
 }
 
 SparseMatrix NewtonIntegrator::newtonMatrix(const Model& model, const State& start, double h,
                                             const Eigen::VectorXd& y) {
   bind(model);
-  const ImplicitStepForm form = this->form(model, start, h);
-  ImplicitStepForm scaled = form;
-  scaled.gamma /= h * h;
-  evaluate(model, scaled, y - start.x);
-  assembleMatrix(form, h);
-  return A_ * (form.gamma / (h * h));
+  form(model, start, h, form_);
+  evaluate(model, form_.gamma / (h * h), y - start.x);
+  assembleMatrix(h);
+  return A_ * (form_.gamma / (h * h));
 }
 
 std::vector<Statistic> NewtonIntegrator::statistics() const {
@@ -189,62 +186,52 @@ std::vector<Statistic> NewtonIntegrator::statistics() const {
   return stats;
 }
 
-ImplicitStepForm BackwardEuler::form(const Model&, const State& s, double h) {
-  return backwardEulerForm(s, h);
+void BackwardEuler::form(const Model&, const State& s, double h, ImplicitStepForm& f) {
+  backwardEulerForm(s, h, f);
 }
 
-ImplicitStepForm ImplicitMidpoint::form(const Model&, const State& s, double h) {
-  ImplicitStepForm f;
+void ImplicitMidpoint::form(const Model&, const State& s, double h, ImplicitStepForm& f) {
   f.gamma = 2.0;
   f.theta = 0.5;
   f.sigma = 1.0 / h;
   f.sigmaNew = 2.0 / h;
   f.x0 = s.x;
   f.dPred = h * s.v;
-  f.vConst = Eigen::VectorXd::Zero(s.v.size());
+  f.vConst.setZero(s.v.size());
   f.vNewConst = -s.v;
-  return f;
 }
 
-namespace {
-
-ImplicitStepForm newmarkForm(const Model& model, const State& s, double h, Eigen::VectorXd& a0) {
-  model.acceleration(s.x, s.v, a0);
-  ImplicitStepForm f;
+void Newmark::form(const Model& model, const State& s, double h, ImplicitStepForm& f) {
+  model.acceleration(s.x, s.v, a0_);
   f.gamma = 4.0;
   f.theta = 1.0;
   f.sigma = f.sigmaNew = 2.0 / h;
   f.x0 = s.x;
-  f.dPred = h * s.v + (0.25 * h * h) * a0;
-  f.vConst = f.vNewConst = -s.v;
-  return f;
+  f.dPred = h * s.v + (0.25 * h * h) * a0_;
+  f.vConst = -s.v;
+  f.vNewConst = -s.v;
 }
 
-}  // namespace
-
-ImplicitStepForm Newmark::form(const Model& model, const State& s, double h) {
-  return newmarkForm(model, s, h, a0_);
-}
-
-ImplicitStepForm Bdf2::form(const Model&, const State& s, double h) {
+void Bdf2::form(const Model&, const State& s, double h, ImplicitStepForm& f) {
   const bool continues = history_ && h == h_ && s.t == last_.t && s.x == last_.x && s.v == last_.v;
+  current_ = s;  // the step's start: the history after it is accepted
   if (!continues) {
     ++startSteps_;
-    return backwardEulerForm(s, h);
+    backwardEulerForm(s, h, f);
+    return;
   }
   const State& p = previous_;  // (x0, v0); s is (x1, v1)
-  ImplicitStepForm f;
   f.gamma = 9.0 / 4.0;
   f.theta = 1.0;
   f.sigma = f.sigmaNew = 3.0 / (2.0 * h);
   f.x0 = s.x;
   f.dPred = (s.x - p.x) / 3.0 + (2.0 * h / 9.0) * (4.0 * s.v - p.v);
-  f.vConst = f.vNewConst = (p.x - s.x) / (2.0 * h);
-  return f;
+  f.vConst = (p.x - s.x) / (2.0 * h);
+  f.vNewConst = f.vConst;
 }
 
-void Bdf2::accepted(const State& before, const State& after, double h) {
-  previous_ = before;
+void Bdf2::accepted(const State& after, double h) {
+  std::swap(previous_, current_);
   last_ = after;
   h_ = h;
   history_ = true;

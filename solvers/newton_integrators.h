@@ -56,7 +56,8 @@ struct ImplicitStepForm {
 
 class NewtonIntegrator : public Integrator {
  public:
-  explicit NewtonIntegrator(ImplicitOptions options);
+  explicit NewtonIntegrator(const ImplicitOptions& options = {});
+  explicit NewtonIntegrator(const SolverOptions& options) : NewtonIntegrator(options.implicit) {}
 
   StepResult step(const Model& model, State& state, double h) override;
   std::vector<Statistic> statistics() const override;
@@ -76,18 +77,17 @@ class NewtonIntegrator : public Integrator {
                             const Eigen::VectorXd& y);
 
  protected:
-  // The method's form for a step of h from `state`.
-  virtual ImplicitStepForm form(const Model& model, const State& state, double h) = 0;
-  // Called after an accepted step from `before` (history for multistep methods).
-  virtual void accepted(const State& before, const State& after, double h) {
-    (void)before, (void)after, (void)h;
-  }
+  // Fills f, the method's form for a step of h from `state` (f's vectors are reused).
+  virtual void form(const Model& model, const State& state, double h, ImplicitStepForm& f) = 0;
+  // Called with the state an accepted step ended at (history for multistep methods).
+  virtual void accepted(const State& after, double h) { (void)after, (void)h; }
 
  private:
   void bind(const Model& model);
-  void evaluate(const Model& model, const ImplicitStepForm& form, const Eigen::VectorXd& y);
-  double merit(const Model& model, const ImplicitStepForm& form, const Eigen::VectorXd& y);
-  void assembleMatrix(const ImplicitStepForm& form, double h);
+  // inertia = gamma/h^2; all three work on form_.
+  void evaluate(const Model& model, double inertia, const Eigen::VectorXd& d);
+  double merit(const Model& model, double inertia, const Eigen::VectorXd& d);
+  void assembleMatrix(double h);
 
   ImplicitOptions options_;
   long modelId_ = -1;
@@ -95,7 +95,8 @@ class NewtonIntegrator : public Integrator {
   SparseMatrix A_;
   SpdSolver solver_;
   // Workspaces: positions and velocities where forces are evaluated, force, residual, update.
-  Eigen::VectorXd d_, xe_, ve_, f_, r_, rhs_, delta_, trial_, external_, dv_;
+  ImplicitStepForm form_;  // the current step's
+  Eigen::VectorXd d_, dTrial_, xe_, ve_, f_, r_, rhs_, delta_, trial_, external_, dv_;
   int lastIterations_ = 0;
   double lastResidual_ = 0.0;
   bool lastConverged_ = true;
@@ -104,37 +105,36 @@ class NewtonIntegrator : public Integrator {
   double assembleSeconds_ = 0.0;
 };
 
+// The four methods state only their forms; construction is the base's (ImplicitOptions or
+// SolverOptions).
 // implicit: backward Euler.
 class BackwardEuler final : public NewtonIntegrator {
  public:
-  explicit BackwardEuler(ImplicitOptions options = {}) : NewtonIntegrator(options) {}
-  explicit BackwardEuler(const SolverOptions& options) : BackwardEuler(options.implicit) {}
+  using NewtonIntegrator::NewtonIntegrator;
   IntegratorKind kind() const override { return IntegratorKind::Implicit; }
 
  protected:
-  ImplicitStepForm form(const Model& model, const State& state, double h) override;
+  void form(const Model& model, const State& state, double h, ImplicitStepForm& f) override;
 };
 
 // midpoint: implicit midpoint rule.
 class ImplicitMidpoint final : public NewtonIntegrator {
  public:
-  explicit ImplicitMidpoint(ImplicitOptions options = {}) : NewtonIntegrator(options) {}
-  explicit ImplicitMidpoint(const SolverOptions& options) : ImplicitMidpoint(options.implicit) {}
+  using NewtonIntegrator::NewtonIntegrator;
   IntegratorKind kind() const override { return IntegratorKind::Midpoint; }
 
  protected:
-  ImplicitStepForm form(const Model& model, const State& state, double h) override;
+  void form(const Model& model, const State& state, double h, ImplicitStepForm& f) override;
 };
 
 // newmark: average-acceleration Newmark (gamma 1/2, beta 1/4), the trapezoidal rule.
 class Newmark final : public NewtonIntegrator {
  public:
-  explicit Newmark(ImplicitOptions options = {}) : NewtonIntegrator(options) {}
-  explicit Newmark(const SolverOptions& options) : Newmark(options.implicit) {}
+  using NewtonIntegrator::NewtonIntegrator;
   IntegratorKind kind() const override { return IntegratorKind::Newmark; }
 
  protected:
-  ImplicitStepForm form(const Model& model, const State& state, double h) override;
+  void form(const Model& model, const State& state, double h, ImplicitStepForm& f) override;
 
  private:
   Eigen::VectorXd a0_;
@@ -143,19 +143,19 @@ class Newmark final : public NewtonIntegrator {
 // bdf2: second-order backward differentiation, started by backward Euler.
 class Bdf2 final : public NewtonIntegrator {
  public:
-  explicit Bdf2(ImplicitOptions options = {}) : NewtonIntegrator(options) {}
-  explicit Bdf2(const SolverOptions& options) : Bdf2(options.implicit) {}
+  using NewtonIntegrator::NewtonIntegrator;
   IntegratorKind kind() const override { return IntegratorKind::Bdf2; }
   void restart() override { history_ = false; }
   long startSteps() const { return startSteps_; }  // backward-Euler steps taken to (re)start
 
  protected:
-  ImplicitStepForm form(const Model& model, const State& state, double h) override;
-  void accepted(const State& before, const State& after, double h) override;
+  void form(const Model& model, const State& state, double h, ImplicitStepForm& f) override;
+  void accepted(const State& after, double h) override;
 
  private:
   bool history_ = false;
-  State previous_, last_;  // the state before the last step, and the last step's result
+  // The state before the last step, the current step's start, and the last step's result.
+  State previous_, current_, last_;
   double h_ = 0.0;
   long startSteps_ = 0;
 };

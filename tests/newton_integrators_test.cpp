@@ -166,23 +166,23 @@ TEST(NewtonIntegrators, NewtonFinishesAtRestAndOnceTheMotionStops) {
   }
 }
 
-TEST(ImplicitMidpoint, ConservesTheEnergyOfAnUndampedLinearSpringAtHwTen) {
+// On a linear system midpoint and the trapezoidal rule have |R| = 1 for every mode.
+template <class Method>
+void expectLinearSpringEnergyKeptAtHwTen() {
   const test::LinearOscillator osc;
-  ImplicitMidpoint midpoint;
+  Method method;
   State s = osc.start();
   const double e0 = osc.energy(s), h = 10.0 / osc.omega();
-  for (int i = 0; i < 1000; ++i) ASSERT_TRUE(midpoint.step(osc.model, s, h).ok);
+  for (int i = 0; i < 1000; ++i) ASSERT_TRUE(method.step(osc.model, s, h).ok);
   EXPECT_NEAR(osc.energy(s) / e0, 1.0, 1e-9);
 }
 
+TEST(ImplicitMidpoint, ConservesTheEnergyOfAnUndampedLinearSpringAtHwTen) {
+  expectLinearSpringEnergyKeptAtHwTen<ImplicitMidpoint>();
+}
+
 TEST(Newmark, ConservesTheEnergyOfAnUndampedLinearSpringAtHwTen) {
-  // On a linear system the trapezoidal rule has |R| = 1 for every mode, like midpoint.
-  const test::LinearOscillator osc;
-  Newmark newmark;
-  State s = osc.start();
-  const double e0 = osc.energy(s), h = 10.0 / osc.omega();
-  for (int i = 0; i < 1000; ++i) ASSERT_TRUE(newmark.step(osc.model, s, h).ok);
-  EXPECT_NEAR(osc.energy(s) / e0, 1.0, 1e-9);
+  expectLinearSpringEnergyKeptAtHwTen<Newmark>();
 }
 
 }  // namespace
