@@ -216,7 +216,6 @@ void Bdf2::form(const Model&, const State& s, double h, ImplicitStepForm& f) {
   const bool continues = history_ && h == h_ && s.t == last_.t && s.x == last_.x && s.v == last_.v;
   current_ = s;  // the step's start: the history after it is accepted
   if (!continues) {
-    ++startSteps_;
     backwardEulerForm(s, h, f);
     return;
   }

@@ -146,7 +146,6 @@ class Bdf2 final : public NewtonIntegrator {
   using NewtonIntegrator::NewtonIntegrator;
   IntegratorKind kind() const override { return IntegratorKind::Bdf2; }
   void restart() override { history_ = false; }
-  long startSteps() const { return startSteps_; }  // backward-Euler steps taken to (re)start
 
  protected:
   void form(const Model& model, const State& state, double h, ImplicitStepForm& f) override;
@@ -157,7 +156,6 @@ class Bdf2 final : public NewtonIntegrator {
   // The state before the last step, the current step's start, and the last step's result.
   State previous_, current_, last_;
   double h_ = 0.0;
-  long startSteps_ = 0;
 };
 
 }  // namespace jello

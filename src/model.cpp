@@ -132,11 +132,6 @@ double Model::fieldWork(const double* x0, const double* x1) const {
   return work;
 }
 
-Vec3 Model::momentum(const State& s) const {
-  const int n = n_;
-  return Vec3{s.v.head(n).sum(), s.v.segment(n, n).sum(), s.v.tail(n).sum()} * mass_;
-}
-
 Vec3 Model::angularMomentum(const State& s) const {
   const int n = n_;
   const Vec3 c{s.x.head(n).mean(), s.x.segment(n, n).mean(), s.x.tail(n).mean()};

@@ -84,8 +84,7 @@ class Model {
   double fieldWork(const double* x0, const double* x1) const;
 
   Energy energy(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const;
-  // Linear momentum (kg m/s) and angular momentum about the centre of mass (kg m^2/s).
-  Vec3 momentum(const State& s) const;
+  // Angular momentum about the centre of mass (kg m^2/s).
   Vec3 angularMomentum(const State& s) const;
   // Spring plus contact energy (J) at positions x (3n): the potential of the elastic forces.
   double potentialEnergy(const double* x) const;
