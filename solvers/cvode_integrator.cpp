@@ -64,7 +64,9 @@ std::string cvodeError(const char* call, int flag) {
 
 }  // namespace
 
-CvodeIntegrator::CvodeIntegrator(CvodeOptions options) : options_(options) {}
+CvodeIntegrator::CvodeIntegrator(CvodeOptions options)
+    : options_(options),
+      system_(options.linearSolver, options.cgTolerance, options.clampCompression) {}
 
 CvodeIntegrator::~CvodeIntegrator() {
   // CVODE first (it refers to the solver, matrix and vector), the context last.
@@ -98,9 +100,8 @@ StepResult CvodeIntegrator::start(const Model& model, const State& s) {
     context_.reset(ctx);
     y_.reset(N_VNew_Serial(2 * n3_, ctx));
     if (!y_) return StepResult::failure("N_VNew_Serial failed");
-    jacobian_ = std::make_unique<JacobianAssembler>(model);
-    A_ = jacobian_->pattern();
-    solver_ = std::make_unique<SpdSolver>(options_.linearSolver, options_.cgTolerance);
+    // A new model: the system rebuilds its pattern and its solver analyses afresh.
+    system_.bind(model);
     b_.setZero(n3_);
   }
   double* y = N_VGetArrayPointer(y_.get());
@@ -183,24 +184,24 @@ int CvodeIntegrator::rightHandSide(const double* y, double* ydot) {
 int CvodeIntegrator::linearSystem(const double* y, bool jacobianOk, bool* jacobianCurrent,
                                   double gamma) {
   if (!jacobianOk || !assembled_) {
-    jacobian_->assemble(y, y + n3_, {options_.clampCompression, false});
+    system_.assemble(y);
     assembled_ = true;
     *jacobianCurrent = true;
   }
   gamma_ = gamma;
-  jacobian_->combine(gamma, gamma * gamma, A_);  // M - g D - g^2 K
+  system_.formMatrix(gamma, gamma * gamma);  // M - g D - g^2 K
   return 0;
 }
 
 int CvodeIntegrator::setupSolver() {
-  return solver_->factorize(A_).ok ? 0 : 1;
+  return system_.factorize().ok ? 0 : 1;
 }
 
 int CvodeIntegrator::solve(const double* b, double* x) {
   const Eigen::Map<const Eigen::VectorXd> r1(b, n3_), r2(b + n3_, n3_);
-  rhs_.noalias() = jacobian_->K() * r1;
+  rhs_.noalias() = system_.K() * r1;
   rhs_ = model_->mass() * r2 + gamma_ * rhs_;
-  if (!solver_->solve(rhs_, b_).ok) return 1;
+  if (!system_.solve(rhs_, b_).ok) return 1;
   Eigen::Map<Eigen::VectorXd>(x + n3_, n3_) = b_;
   Eigen::Map<Eigen::VectorXd>(x, n3_) = r1 + gamma_ * b_;
   return 0;
@@ -224,11 +225,7 @@ std::vector<Statistic> CvodeIntegrator::statistics() const {
   int order = 0;
   if (CVodeGetLastOrder(mem, &order) == CV_SUCCESS) stats.push_back({"last_order", double(order)});
   stats.push_back({"starts", double(restarts_)});  // 1 + restarts from a state set outside
-  if (jacobian_) stats.push_back({"compression_clamps", double(jacobian_->totalClampCount())});
-  if (solver_) {
-    stats.push_back({"factorizations", double(solver_->stats().factorizations)});
-    stats.push_back({"ldlt_fallbacks", double(solver_->stats().fallbacks)});
-  }
+  system_.appendStatistics(stats);
   return stats;
 }
 

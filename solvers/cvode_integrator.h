@@ -3,7 +3,7 @@
 // Its linear systems (I - g J)(a, b) = (r1, r2) are solved through the reduced, symmetric
 // 3n system (src/PHYSICS.md)
 //   (M - g D - g^2 K) b = M r2 + g K r1,   a = r1 + g b,
-// with the same Jacobian assembly and CHOLMOD (or CG) machinery as backward Euler, inside a
+// with the implicit integrators' own system (solvers/implicit_system.h), inside a
 // custom linear solver of DIRECT type, so CVODE keeps its own heuristics for when to refresh
 // the Jacobian and refactor, and its correction for a changed g. One step() call advances the
 // state to t + h (an output interval), CVODE choosing its own internal steps.
@@ -11,9 +11,8 @@
 
 #include <memory>
 
+#include "solvers/implicit_system.h"
 #include "solvers/integrator.h"
-#include "solvers/jacobian.h"
-#include "solvers/linear_solver.h"
 #include "solvers/sundials_handles.h"
 
 namespace jello {
@@ -48,9 +47,7 @@ class CvodeIntegrator final : public Integrator {
   sundials::Matrix matrix_;
   sundials::LinearSolver linearSolver_;
   sundials::CvodeMemory cvode_;
-  std::unique_ptr<JacobianAssembler> jacobian_;
-  SparseMatrix A_;
-  std::unique_ptr<SpdSolver> solver_;
+  ImplicitSystem system_;
   double gamma_ = 0.0;  // of the matrix last formed
   bool assembled_ = false;
   Eigen::VectorXd rhs_, b_;

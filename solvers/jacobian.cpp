@@ -17,11 +17,6 @@ int slotOf(const SparseMatrix& m, int row, int col) {
   return static_cast<int>(it - m.innerIndexPtr());
 }
 
-// block += B, both 3x3 row-major.
-inline void addBlock(double* block, const double B[9]) {
-  for (int e = 0; e < 9; ++e) block[e] += B[e];
-}
-
 // True when m equals its transpose to round-off (a costly check: JELLO_VALIDATE only). A matrix
 // with a non-finite entry passes: that is a diverging state, which Simulation reports, not a
 // structural error.
@@ -34,18 +29,18 @@ inline void addBlock(double* block, const double B[9]) {
 
 }  // namespace
 
-JacobianAssembler::JacobianAssembler(const Model& model)
-    : model_(model), springs_(model.springs().springs()) {
+JacobianAssembler::JacobianAssembler(const Model& model) : model_(model) {
   const int n = model.numPoints();
+  const std::vector<Spring> springs = model.springs().springs();
   // The pattern: every point's diagonal block and both off-diagonal blocks of every spring.
   std::vector<Eigen::Triplet<double, int>> entries;
-  entries.reserve(9 * (static_cast<std::size_t>(n) + 2 * springs_.size()));
+  entries.reserve(9 * (static_cast<std::size_t>(n) + 2 * springs.size()));
   auto block = [&](int p, int q) {
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) entries.emplace_back(r * n + p, c * n + q, 0.0);
   };
   for (int p = 0; p < n; ++p) block(p, p);
-  for (const Spring& s : springs_) {
+  for (const Spring& s : springs) {
     block(s.a, s.b);
     block(s.b, s.a);
   }
@@ -58,8 +53,8 @@ JacobianAssembler::JacobianAssembler(const Model& model)
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) out.push_back(slotOf(K_, r * n + p, c * n + q));
   };
-  springSlots_.reserve(18 * springs_.size());
-  for (const Spring& s : springs_) {
+  springSlots_.reserve(18 * springs.size());
+  for (const Spring& s : springs) {
     slots(springSlots_, s.a, s.b);
     slots(springSlots_, s.b, s.a);
   }
@@ -70,103 +65,25 @@ JacobianAssembler::JacobianAssembler(const Model& model)
   for (int i = 0; i < 3 * n; ++i) diagonal_.push_back(slotOf(K_, i, i));
 }
 
-void JacobianAssembler::assemble(const double* x, const double* v, const JacobianOptions& options) {
-  (void)v;  // D does not depend on v: the forces are linear in v
-  const int n = model_.numPoints();
-  double* Kv = K_.valuePtr();
-  double* Dv = D_.valuePtr();
+void JacobianAssembler::assemble(const double* x, const JacobianOptions& options) {
   // Diagonal blocks gather from many springs and from contact: into dense per-point arrays,
   // scattered into the matrices once at the end. Each off-diagonal block belongs to exactly one
   // spring, which assigns it: no zeroing, no accumulation.
   std::fill(diagK_.begin(), diagK_.end(), 0.0);
   std::fill(diagD_.begin(), diagD_.end(), 0.0);
-
-  long clamps = 0;
-  for (std::size_t s = 0; s < springs_.size(); ++s) {
-    const int a = springs_[s].a, b = springs_[s].b;
-    const double d[3] = {x[b] - x[a], x[n + b] - x[n + a], x[2 * n + b] - x[2 * n + a]};
-    const double inv = 1.0 / std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    const double u[3] = {d[0] * inv, d[1] * inv, d[2] * inv};
-    double alpha = 1.0 - springs_[s].rest * inv;
-    if (options.clampCompression && alpha < 0.0) {
-      alpha = 0.0;
-      ++clamps;
-    }
-    const double k = springs_[s].stiffness, c = springs_[s].damping;
-    const int* slot = &springSlots_[18 * s];
-    double* Ka = &diagK_[9 * static_cast<std::size_t>(a)];
-    double* Kb = &diagK_[9 * static_cast<std::size_t>(b)];
-    double* Da = &diagD_[9 * static_cast<std::size_t>(a)];
-    double* Db = &diagD_[9 * static_cast<std::size_t>(b)];
-    for (int r = 0; r < 3; ++r)
-      for (int q = 0; q < 3; ++q) {
-        const int e = 3 * r + q;
-        const double P = u[r] * u[q];
-        const double Ke = -k * (P + alpha * ((r == q ? 1.0 : 0.0) - P));
-        const double De = -c * P;
-        Ka[e] += Ke;
-        Kb[e] += Ke;
-        Da[e] += De;
-        Db[e] += De;
-        Kv[slot[e]] = -Ke;      // (a,b)
-        Kv[slot[9 + e]] = -Ke;  // (b,a)
-        Dv[slot[e]] = -De;
-        Dv[slot[9 + e]] = -De;
-      }
-  }
-  lastClamps_ = clamps;
-  totalClamps_ += clamps;
-
-  // Contact and field: the point's own diagonal block.
-  auto normalBlock = [](const Vec3& nrm, double scale, double out[9]) {
-    const double u[3] = {nrm.x, nrm.y, nrm.z};
-    for (int r = 0; r < 3; ++r)
-      for (int q = 0; q < 3; ++q) out[3 * r + q] = scale * u[r] * u[q];
-  };
-  double B[9];
-  for (int p = 0; p < n; ++p) {
-    const Vec3 xp{x[p], x[n + p], x[2 * n + p]};
-    double* Kp = &diagK_[9 * static_cast<std::size_t>(p)];
-    double* Dp = &diagD_[9 * static_cast<std::size_t>(p)];
-    if (const auto& walls = model_.walls()) {
-      const ContactConstants& kc = walls->constants();
-      const double coord[3] = {xp.x, xp.y, xp.z};
-      for (int axis = 0; axis < 3; ++axis) {
-        if (std::abs(coord[axis]) <= kBoxHalfSize) continue;
-        Kp[4 * axis] -= kc.stiffness;  // entry (axis, axis) of the block
-        Dp[4 * axis] -= kc.damping;
-      }
-    }
-    if (const auto& plane = model_.plane()) {
-      const Vec3 nrm = plane->normal();
-      if (dot(nrm, xp) + plane->offset() < 0.0) {
-        normalBlock(nrm, -plane->constants().stiffness, B);
-        addBlock(Kp, B);
-        normalBlock(nrm, -plane->constants().damping, B);
-        addBlock(Dp, B);
-      }
-    }
-    if (const auto& sphere = model_.sphere()) {
-      const Vec3 r = xp - sphere->sphere().center;
-      const double l = norm(r), R = sphere->sphere().radius;
-      if (l < R && l > 0.0) {
-        const Vec3 nrm = r * (1.0 / l);
-        const ContactConstants& kc = sphere->constants();
-        // -kc n n^T, plus (unclamped only) the curvature term kc (R/l - 1)(I - n n^T).
-        const double t = options.clampCompression ? 0.0 : kc.stiffness * (R / l - 1.0);
-        normalBlock(nrm, -kc.stiffness - t, B);
-        for (int e = 0; e < 3; ++e) B[4 * e] += t;
-        addBlock(Kp, B);
-        normalBlock(nrm, -kc.damping, B);
-        addBlock(Dp, B);
-      }
-    }
-    if (options.includeField && model_.field()) {
-      double G[3][3];
-      model_.field()->gradient(xp, G);
-      addBlock(Kp, &G[0][0]);
-    }
-  }
+  double* Kv = K_.valuePtr();
+  double* Dv = D_.valuePtr();
+  JacobianBlocks blocks;
+  blocks.diagK = diagK_.data();
+  blocks.diagD = diagD_.data();
+  blocks.K = Kv;
+  blocks.D = Dv;
+  blocks.springSlots = springSlots_.data();
+  blocks.clampCompression = options.clampCompression;
+  blocks.includeField = options.includeField;
+  model_.addJacobian(x, blocks);
+  lastClamps_ = blocks.clamps;
+  totalClamps_ += blocks.clamps;
   for (std::size_t i = 0; i < diagSlots_.size(); ++i) {
     Kv[diagSlots_[i]] = diagK_[i];
     Dv[diagSlots_[i]] = diagD_[i];

@@ -1,19 +1,13 @@
 // The Jacobians of the total force: K = df/dx and D = df/dv (3n x 3n, component-major ordering
 // like the state, N/m and N*s/m), assembled into sparse matrices whose pattern is built once
-// and whose values are refilled in place at every state (no triplets, no re-analysis).
-//
-// Springs (src/PHYSICS.md), u = unit vector along the spring, P = u u^T, alpha = 1 - L0/l:
-//   Ke = -k [ P + alpha (I - P) ]   on blocks (a,a), (b,b);  -Ke on (a,b), (b,a)
-//   De = -c P                        likewise
-// Under compression alpha < 0 and K gains positive directions, so M - h D - h^2 K can become
-// indefinite; the compression clamp replaces alpha by max(alpha, 0), which is the projection
-// of the spring's element Hessian onto semidefinite matrices. It is on by default and counted.
-// The x-derivative of spring damping (non-symmetric) is omitted, as Baraff & Witkin do.
-// Contact (diagonal block of the point only, so the pattern never changes):
-//   walls, plane:  K = -kc n n^T,  D = -dc n n^T
-//   sphere:        K = -kc n n^T + kc (R/l - 1) (I - n n^T)   (the second term is the surface's
-//                  curvature; positive, so the clamp drops it), D = -dc n n^T
-// Force field (optional, off for the implicit solvers): K += dF/dx, the trilinear gradient.
+// and whose values are refilled in place at every state (no triplets, no re-analysis). The
+// terms themselves live beside each effect's force (Model::addJacobian, src/jacobian_blocks.h:
+// springs, walls, plane, sphere, field); this class owns the pattern (every point's diagonal
+// block and both off-diagonal blocks of every spring, which never changes with contact) and
+// scatters the diagonal blocks into it.
+// The compression clamp (on by default, counted) projects each spring's element Hessian onto
+// semidefinite matrices, so M - h D - h^2 K stays positive definite. The field's gradient is
+// not symmetric and is left out unless asked for (not for Cholesky).
 #pragma once
 
 #include <Eigen/SparseCore>
@@ -34,8 +28,9 @@ class JacobianAssembler {
  public:
   explicit JacobianAssembler(const Model& model);
 
-  // Refills K and D at state (x, v), arrays of 3n, component-major.
-  void assemble(const double* x, const double* v, const JacobianOptions& options);
+  // Refills K and D at positions x, 3n component-major (the forces are linear in v: D does not
+  // depend on it).
+  void assemble(const double* x, const JacobianOptions& options);
 
   const SparseMatrix& K() const { return K_; }
   const SparseMatrix& D() const { return D_; }
@@ -50,7 +45,6 @@ class JacobianAssembler {
 
  private:
   const Model& model_;
-  std::vector<Spring> springs_;
   SparseMatrix K_, D_;
   std::vector<int> springSlots_;       // 18 per spring: value index of blocks (a,b), (b,a)
   std::vector<int> diagSlots_;         // 9 per point: value index of its diagonal block

@@ -1,34 +1,21 @@
 #include "solvers/linearized_backward_euler.h"
 
 #include <algorithm>
-#include <chrono>
 
 namespace jello {
 
 LinearizedBackwardEuler::LinearizedBackwardEuler(ImplicitOptions options)
-    : options_(options), solver_(options.linearSolver, options.cgTolerance) {}
+    : options_(options),
+      system_(options.linearSolver, options.cgTolerance, options.clampCompression) {}
 
 void LinearizedBackwardEuler::prepare(const Model& model) {
-  if (model.id() == modelId_) return;
-  modelId_ = model.id();
-  solver_.forgetPattern();
-  jacobian_ = std::make_unique<JacobianAssembler>(model);
-  A_ = jacobian_->pattern();
-  dv_.setZero(3 * model.numPoints());
-}
-
-void LinearizedBackwardEuler::assemble(const double* x, const double* v) {
-  const auto start = std::chrono::steady_clock::now();
-  jacobian_->assemble(x, v, {options_.clampCompression, false});
-  assembleSeconds_ +=
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (system_.bind(model)) dv_.setZero(3 * model.numPoints());
 }
 
 StepResult LinearizedBackwardEuler::factorAndSolve(double h, const Eigen::VectorXd& rhs,
                                                    Eigen::VectorXd& x) {
-  jacobian_->combine(h, h * h, A_);
-  if (StepResult r = solver_.factorize(A_); !r.ok) return r;
-  return solver_.solve(rhs, x);
+  if (StepResult r = system_.factorize(h, h * h); !r.ok) return r;
+  return system_.solve(rhs, x);
 }
 
 double LinearizedBackwardEuler::residual(const Model& model, const State& s, double h) {
@@ -43,8 +30,8 @@ StepResult LinearizedBackwardEuler::step(const Model& model, State& s, double h)
   prepare(model);
   model.forces(s.x, s.v, f_);
   // First iteration, linearized at (x0, v0): rhs = h (f0 + h K v0).
-  assemble(s.x.data(), s.v.data());
-  rhs_.noalias() = jacobian_->K() * s.v;
+  system_.assemble(s.x.data());
+  rhs_.noalias() = system_.K() * s.v;
   rhs_ = h * (f_ + h * rhs_);
   // dv_ still holds the last step's dv: a good first guess for CG.
   if (StepResult r = factorAndSolve(h, rhs_, dv_); !r.ok) return r;
@@ -69,7 +56,7 @@ StepResult LinearizedBackwardEuler::step(const Model& model, State& s, double h)
         break;
       }
       rhs_ = -g_;
-      assemble(x1_.data(), v1_.data());
+      system_.assemble(x1_.data());
       delta_.setZero(rhs_.size());  // a correction: small, so start CG from zero
       if (StepResult r = factorAndSolve(h, rhs_, delta_); !r.ok) return r;
       v1_ += delta_;
@@ -87,21 +74,12 @@ StepResult LinearizedBackwardEuler::step(const Model& model, State& s, double h)
 }
 
 std::vector<Statistic> LinearizedBackwardEuler::statistics() const {
-  const LinearSolverStats& ls = solver_.stats();
   std::vector<Statistic> stats{
       {"newton_iterations", static_cast<double>(newtonIterations_)},
       {"newton_unconverged_steps", static_cast<double>(unconverged_)},
       {"contact_onset_steps", static_cast<double>(contactSteps_)},
-      {"compression_clamps", static_cast<double>(clampCount())},
-      {"factorizations", static_cast<double>(ls.factorizations)},
-      {"ldlt_fallbacks", static_cast<double>(ls.fallbacks)},
-      {"assemble_time_s", assembleSeconds_},
-      {"factor_time_s", ls.factorSeconds},
-      {"solve_time_s", ls.solveSeconds},
   };
-  if (solver_.kind() == LinearSolverKind::Cg) {
-    stats.push_back({"cg_iterations", static_cast<double>(ls.cgIterations)});
-  }
+  system_.appendStatistics(stats);
   return stats;
 }
 

@@ -19,9 +19,8 @@
 
 #include <memory>
 
+#include "solvers/implicit_system.h"
 #include "solvers/integrator.h"
-#include "solvers/jacobian.h"
-#include "solvers/linear_solver.h"
 
 namespace jello {
 
@@ -38,27 +37,22 @@ class LinearizedBackwardEuler final : public Integrator {
   // Relative residual after the last step's final Newton iteration (0 for one iteration).
   double lastResidual() const { return lastResidual_; }
   int lastIterations() const { return lastIterations_; }
-  const SpdSolver& linearSolver() const { return solver_; }
-  long clampCount() const { return jacobian_ ? jacobian_->totalClampCount() : 0; }
+  const SpdSolver& linearSolver() const { return system_.solver(); }
+  long clampCount() const { return system_.clampCount(); }
 
  private:
   void prepare(const Model& model);
   double residual(const Model& model, const State& s, double h);
-  void assemble(const double* x, const double* v);
   // Factors M - h D - h^2 K of the last assembly and solves it for rhs into x (x on entry:
   // CG's initial guess).
   StepResult factorAndSolve(double h, const Eigen::VectorXd& rhs, Eigen::VectorXd& x);
 
   ImplicitOptions options_;
-  long modelId_ = -1;
-  std::unique_ptr<JacobianAssembler> jacobian_;
-  SparseMatrix A_;
-  SpdSolver solver_;
+  ImplicitSystem system_;
   Eigen::VectorXd f_, rhs_, dv_, delta_, v1_, x1_, g_;  // dv_: the last step's, CG's warm start
   double lastResidual_ = 0.0;
   int lastIterations_ = 0;
   long steps_ = 0, newtonIterations_ = 0, unconverged_ = 0, contactSteps_ = 0;
-  double assembleSeconds_ = 0.0;
 };
 
 }  // namespace jello

@@ -1,6 +1,5 @@
 #include "solvers/newton_integrators.h"
 
-#include <chrono>
 #include <cmath>
 
 namespace jello {
@@ -18,19 +17,26 @@ void backwardEulerForm(const State& s, double h, ImplicitStepForm& f) {
   f.vNewConst.setZero(s.v.size());
 }
 
+void midpointForm(const State& s, double h, ImplicitStepForm& f) {
+  f.gamma = 2.0;
+  f.theta = 0.5;
+  f.sigma = 1.0 / h;
+  f.sigmaNew = 2.0 / h;
+  f.x0 = s.x;
+  f.dPred = h * s.v;
+  f.vConst.setZero(s.v.size());
+  f.vNewConst = -s.v;
+}
+
 }  // namespace
 
 NewtonIntegrator::NewtonIntegrator(const ImplicitOptions& options)
-    : options_(options), solver_(options.linearSolver, options.cgTolerance) {}
+    : options_(options),
+      system_(options.linearSolver, options.cgTolerance, options.clampCompression) {}
 
 void NewtonIntegrator::bind(const Model& model) {
-  if (model.id() == modelId_) return;
-  const bool rebinding = modelId_ >= 0;
-  modelId_ = model.id();
-  if (rebinding) restart();  // history from another model means nothing here
-  jacobian_ = std::make_unique<JacobianAssembler>(model);
-  A_ = jacobian_->pattern();
-  solver_.forgetPattern();
+  const bool rebinding = system_.bound();
+  if (system_.bind(model) && rebinding) restart();  // another model's history means nothing
 }
 
 // x_e, v_e, f and the residual r at displacement d; inertia = gamma/h^2.
@@ -53,19 +59,15 @@ double NewtonIntegrator::merit(const Model& model, double inertia, const Eigen::
   xe_ = form.x0 + form.theta * d;
   ve_ = form.sigma * d + form.vConst;
   e += (model.potentialEnergy(xe_.data()) - external_.dot(xe_)) / form.theta;
-  dv_.noalias() = jacobian_->D() * ve_;
+  dv_.noalias() = system_.D() * ve_;
   e += -0.5 * ve_.dot(dv_) / form.sigma;
   return e;
 }
 
-void NewtonIntegrator::assembleMatrix(double h) {
-  const ImplicitStepForm& form = form_;
-  const auto start = std::chrono::steady_clock::now();
-  jacobian_->assemble(xe_.data(), ve_.data(), {options_.clampCompression, false});
-  assembleSeconds_ +=
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const double scale = h * h / form.gamma;
-  jacobian_->combine(form.sigma * scale, form.theta * scale, A_);
+StepResult NewtonIntegrator::factorNewtonMatrix(double h) {
+  system_.assemble(xe_.data());
+  const double scale = h * h / form_.gamma;
+  return system_.factorize(form_.sigma * scale, form_.theta * scale);
 }
 
 StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
@@ -87,11 +89,10 @@ StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
     if (iterations >= options_.newtonMaxIterations) break;
     ++iterations;
     // Newton: (h^2/gamma) J delta = -(h^2/gamma) r. x_e, v_e are those of d_ (evaluate).
-    assembleMatrix(h);
     rhs_ = (-h * h / form.gamma) * r_;
     delta_.setZero(rhs_.size());
-    if (StepResult res = solver_.factorize(A_); !res.ok) return res;
-    if (StepResult res = solver_.solve(rhs_, delta_); !res.ok) return res;
+    if (StepResult res = factorNewtonMatrix(h); !res.ok) return res;
+    if (StepResult res = system_.solve(rhs_, delta_); !res.ok) return res;
     if (!delta_.allFinite()) return StepResult::failure("Newton produced a non-finite update");
     // An update this small is the answer to within it: the floor that ends the iterations at
     // rest, where round-off keeps the relative residual from falling.
@@ -160,12 +161,13 @@ SparseMatrix NewtonIntegrator::newtonMatrix(const Model& model, const State& sta
   bind(model);
   form(model, start, h, form_);
   evaluate(model, form_.gamma / (h * h), y - start.x);
-  assembleMatrix(h);
-  return A_ * (form_.gamma / (h * h));
+  system_.assemble(xe_.data());
+  const double scale = h * h / form_.gamma;
+  system_.formMatrix(form_.sigma * scale, form_.theta * scale);
+  return system_.A() * (form_.gamma / (h * h));
 }
 
 std::vector<Statistic> NewtonIntegrator::statistics() const {
-  const LinearSolverStats& ls = solver_.stats();
   std::vector<Statistic> stats{
       {"newton_iterations", static_cast<double>(iterations_)},
       {"newton_iterations_per_step", steps_ ? double(iterations_) / double(steps_) : 0.0},
@@ -173,16 +175,8 @@ std::vector<Statistic> NewtonIntegrator::statistics() const {
       {"newton_unconverged_steps", static_cast<double>(unconverged_)},
       {"line_search_cuts", static_cast<double>(cuts_)},
       {"line_search_failures", static_cast<double>(searchFailures_)},
-      {"compression_clamps", static_cast<double>(jacobian_ ? jacobian_->totalClampCount() : 0)},
-      {"factorizations", static_cast<double>(ls.factorizations)},
-      {"ldlt_fallbacks", static_cast<double>(ls.fallbacks)},
-      {"assemble_time_s", assembleSeconds_},
-      {"factor_time_s", ls.factorSeconds},
-      {"solve_time_s", ls.solveSeconds},
   };
-  if (options_.linearSolver == LinearSolverKind::Cg) {
-    stats.push_back({"cg_iterations", static_cast<double>(ls.cgIterations)});
-  }
+  system_.appendStatistics(stats);
   return stats;
 }
 
@@ -191,14 +185,7 @@ void BackwardEuler::form(const Model&, const State& s, double h, ImplicitStepFor
 }
 
 void ImplicitMidpoint::form(const Model&, const State& s, double h, ImplicitStepForm& f) {
-  f.gamma = 2.0;
-  f.theta = 0.5;
-  f.sigma = 1.0 / h;
-  f.sigmaNew = 2.0 / h;
-  f.x0 = s.x;
-  f.dPred = h * s.v;
-  f.vConst.setZero(s.v.size());
-  f.vNewConst = -s.v;
+  midpointForm(s, h, f);
 }
 
 void Newmark::form(const Model& model, const State& s, double h, ImplicitStepForm& f) {

@@ -2,8 +2,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 namespace jello {
+namespace {
+
+// block += scale * u u^T, block 3x3 row-major.
+void addOuter(double* block, const Vec3& u, double scale) {
+  const double c[3] = {u.x, u.y, u.z};
+  for (int r = 0; r < 3; ++r)
+    for (int q = 0; q < 3; ++q) block[3 * r + q] += scale * c[r] * c[q];
+}
+
+double* blockOf(double* diag, int p) {
+  return diag + 9 * static_cast<std::ptrdiff_t>(p);
+}
+
+}  // namespace
 
 // The loops below are branch-free (selects, an OR reduction) so that they vectorize: they run
 // in every force evaluation.
@@ -33,6 +48,15 @@ double WallContact::energy(const double* x, int n) const {
     e += depth * depth;
   }
   return 0.5 * k_.stiffness * e;
+}
+
+void WallContact::addJacobian(const double* x, int n, JacobianBlocks& out) const {
+  for (int axis = 0; axis < 3; ++axis)
+    for (int p = 0; p < n; ++p) {
+      if (std::abs(x[axis * n + p]) <= kBoxHalfSize) continue;
+      blockOf(out.diagK, p)[4 * axis] -= k_.stiffness;  // entry (axis, axis) of the block
+      blockOf(out.diagD, p)[4 * axis] -= k_.damping;
+    }
 }
 
 PlaneContact::PlaneContact(const Plane& plane, ContactConstants k) : k_(k) {
@@ -65,6 +89,15 @@ double PlaneContact::energy(const double* x, int n) const {
   return 0.5 * k_.stiffness * e;
 }
 
+void PlaneContact::addJacobian(const double* x, int n, JacobianBlocks& out) const {
+  for (int p = 0; p < n; ++p) {
+    const Vec3 xp{x[p], x[n + p], x[2 * n + p]};
+    if (dot(normal_, xp) + offset_ >= 0.0) continue;
+    addOuter(blockOf(out.diagK, p), normal_, -k_.stiffness);
+    addOuter(blockOf(out.diagD, p), normal_, -k_.damping);
+  }
+}
+
 void SphereContact::accumulate(const double* x, const double* v, double* f, int n) const {
   const Vec3 c = sphere_.center;
   const double r = sphere_.radius;
@@ -91,6 +124,22 @@ double SphereContact::energy(const double* x, int n) const {
     if (depth > 0.0) e += depth * depth;
   }
   return 0.5 * k_.stiffness * e;
+}
+
+void SphereContact::addJacobian(const double* x, int n, JacobianBlocks& out) const {
+  const double R = sphere_.radius;
+  for (int p = 0; p < n; ++p) {
+    const Vec3 r = Vec3{x[p], x[n + p], x[2 * n + p]} - sphere_.center;
+    const double l = norm(r);
+    if (!(l < R && l > 0.0)) continue;
+    const Vec3 u = r * (1.0 / l);
+    // The curvature term kc (R/l - 1)(I - n n^T): positive, dropped by the clamp.
+    const double t = out.clampCompression ? 0.0 : k_.stiffness * (R / l - 1.0);
+    double* K = blockOf(out.diagK, p);
+    addOuter(K, u, -k_.stiffness - t);
+    for (int e = 0; e < 3; ++e) K[4 * e] += t;
+    addOuter(blockOf(out.diagD, p), u, -k_.damping);
+  }
 }
 
 }  // namespace jello

@@ -6,6 +6,7 @@
 // solid inside, n radial.
 #pragma once
 
+#include "src/jacobian_blocks.h"
 #include "src/world.h"
 
 namespace jello {
@@ -26,6 +27,8 @@ class WallContact {
   static bool allInside(const double* x, int n);
   void accumulate(const double* x, const double* v, double* f, int n) const;
   double energy(const double* x, int n) const;
+  // K = -kc e_c e_c^T, D = -dc e_c e_c^T on the diagonal block of each violated wall's point.
+  void addJacobian(const double* x, int n, JacobianBlocks& out) const;
 
  private:
   ContactConstants k_;
@@ -36,6 +39,8 @@ class PlaneContact {
   PlaneContact(const Plane& plane, ContactConstants k);
   void accumulate(const double* x, const double* v, double* f, int n) const;
   double energy(const double* x, int n) const;
+  // K = -kc n n^T, D = -dc n n^T for each point on the solid side.
+  void addJacobian(const double* x, int n, JacobianBlocks& out) const;
   const Vec3& normal() const { return normal_; }  // unit, into free space
   double offset() const { return offset_; }       // signed distance = normal.x + offset
   const ContactConstants& constants() const { return k_; }
@@ -53,6 +58,9 @@ class SphereContact {
   const ContactConstants& constants() const { return k_; }
   void accumulate(const double* x, const double* v, double* f, int n) const;
   double energy(const double* x, int n) const;
+  // For each point inside, n radial: K = -kc n n^T + kc (R/l - 1)(I - n n^T) (the second term
+  // is the surface's curvature; positive, so the clamp drops it), D = -dc n n^T.
+  void addJacobian(const double* x, int n, JacobianBlocks& out) const;
 
  private:
   Sphere sphere_;

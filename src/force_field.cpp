@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 #include "src/assertions.h"
 #include "src/contact.h"
@@ -98,6 +99,16 @@ void FieldForces::accumulate(const double* x, double* f, int n) const {
     f[p] += F.x;
     f[n + p] += F.y;
     f[2 * n + p] += F.z;
+  }
+}
+
+void FieldForces::addJacobian(const double* x, int n, JacobianBlocks& out) const {
+  if (!out.includeField || uniform_) return;  // a uniform field has no gradient
+  double G[3][3];
+  for (int p = 0; p < n; ++p) {
+    gradient(Vec3{x[p], x[n + p], x[2 * n + p]}, G);
+    double* K = out.diagK + 9 * static_cast<std::ptrdiff_t>(p);
+    for (int e = 0; e < 9; ++e) K[e] += G[e / 3][e % 3];
   }
 }
 

@@ -5,6 +5,7 @@
 // interpolation); an all-zero field is no effect at all (the Model leaves it out).
 #pragma once
 
+#include "src/jacobian_blocks.h"
 #include "src/world.h"
 
 namespace jello {
@@ -19,6 +20,8 @@ class FieldForces {
   void gradient(const Vec3& position, double out[3][3]) const;
   // Adds the field force at each of the n points (component-major x) to f.
   void accumulate(const double* x, double* f, int n) const;
+  // Adds gradient() to each point's diagonal block of K (only with out.includeField).
+  void addJacobian(const double* x, int n, JacobianBlocks& out) const;
 
   bool isUniform() const { return uniform_; }
   bool isZero() const { return uniform_ && constant_ == Vec3{}; }

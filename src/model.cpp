@@ -100,6 +100,14 @@ void Model::acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
   acceleration(x.data(), v.data(), a.data());
 }
 
+void Model::addJacobian(const double* x, JacobianBlocks& out) const {
+  springs_.addJacobian(x, out);
+  if (walls_) walls_->addJacobian(x, n_, out);
+  if (plane_) plane_->addJacobian(x, n_, out);
+  if (sphere_) sphere_->addJacobian(x, n_, out);
+  if (field_) field_->addJacobian(x, n_, out);
+}
+
 bool Model::contactBegins(const double* x0, const double* x1) const {
   const int n = n_;
   if (walls_) {

@@ -93,6 +93,11 @@ class Model {
   void externalForces(const double* x, Eigen::VectorXd& f) const;
   Energy energy(const State& s) const { return energy(s.x, s.v); }
 
+  // Adds every effect's Jacobian blocks at positions x (src/jacobian_blocks.h): the springs,
+  // and the walls, plane, sphere and field where the scene has them. The user force is
+  // constant and adds nothing.
+  void addJacobian(const double* x, JacobianBlocks& out) const;
+
   const SpringForces& springs() const { return springs_; }
   // The effects, for Jacobian assembly: empty when the scene does not have them.
   const std::optional<WallContact>& walls() const { return walls_; }

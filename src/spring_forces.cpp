@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 #include "src/assertions.h"
 
@@ -182,6 +183,48 @@ double SpringForces::energy(const double* x) const {
     e += 0.5 * g.stiffness * eg;
   }
   return e;
+}
+
+void SpringForces::addJacobian(const double* x, JacobianBlocks& out) const {
+  const int n = n_;
+  const int* slot = out.springSlots;  // in the order of springs(): groups, then base points
+  long clamps = 0;
+  for (const SpringGroup& g : groups_) {
+    const double k = g.stiffness, c = g.damping;
+    for (int i = 0; i < static_cast<int>(g.mask.size()); ++i) {
+      if (g.mask[i] == 0.0) continue;
+      const int a = g.first + i, b = a + g.delta;
+      const double d[3] = {x[b] - x[a], x[n + b] - x[n + a], x[2 * n + b] - x[2 * n + a]};
+      const double inv = 1.0 / std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      const double u[3] = {d[0] * inv, d[1] * inv, d[2] * inv};
+      double alpha = 1.0 - g.rest * inv;
+      if (out.clampCompression && alpha < 0.0) {
+        alpha = 0.0;
+        ++clamps;
+      }
+      double* Ka = out.diagK + 9 * static_cast<std::ptrdiff_t>(a);
+      double* Kb = out.diagK + 9 * static_cast<std::ptrdiff_t>(b);
+      double* Da = out.diagD + 9 * static_cast<std::ptrdiff_t>(a);
+      double* Db = out.diagD + 9 * static_cast<std::ptrdiff_t>(b);
+      for (int r = 0; r < 3; ++r)
+        for (int q = 0; q < 3; ++q) {
+          const int e = 3 * r + q;
+          const double P = u[r] * u[q];
+          const double Ke = -k * (P + alpha * ((r == q ? 1.0 : 0.0) - P));
+          const double De = -c * P;
+          Ka[e] += Ke;
+          Kb[e] += Ke;
+          Da[e] += De;
+          Db[e] += De;
+          out.K[slot[e]] = -Ke;      // (a,b)
+          out.K[slot[9 + e]] = -Ke;  // (b,a)
+          out.D[slot[e]] = -De;
+          out.D[slot[9 + e]] = -De;
+        }
+      slot += 18;
+    }
+  }
+  out.clamps += clamps;
 }
 
 std::vector<Spring> SpringForces::springs() const {

@@ -10,6 +10,7 @@
 
 #include <vector>
 
+#include "src/jacobian_blocks.h"
 #include "src/lattice.h"
 
 namespace jello {
@@ -45,6 +46,12 @@ class SpringForces {
   // state: threads may evaluate one SpringForces at once.
   void accumulate(const double* x, const double* v, double* f) const;
   double energy(const double* x) const;  // J
+  // Adds the springs' blocks of K and D at positions x (the forces are linear in v, so D does
+  // not depend on it), u the unit vector along a spring, P = u u^T, alpha = 1 - L0/l:
+  //   Ke = -k [ P + alpha (I - P) ],  De = -c P   on (a,a) and (b,b); -Ke, -De on (a,b), (b,a).
+  // With out.clampCompression, alpha < 0 (compression) is replaced by 0 and counted. The
+  // x-derivative of spring damping (not symmetric) is left out, as Baraff & Witkin do.
+  void addJacobian(const double* x, JacobianBlocks& out) const;
 
   int numSprings() const { return numSprings_; }
   const std::vector<SpringGroup>& groups() const { return groups_; }

@@ -47,15 +47,24 @@ TEST(NewtonIntegrators, ConvergeWithTheirOrders) {
 
 // The spinning, 5% stretched stiff cube, undamped, h = 0.01, for 0.2 s: how much angular
 // momentum about the centre of mass each method keeps.
+// Every step must converge: a step accepted at the iteration cap keeps what it keeps by chance.
 double angularMomentumKept(IntegratorKind kind, double k, double newtonTolerance = 1e-8) {
   SceneSpec spec = vibratingStiffCube(k);
   spec.dElastic = 0.0;
   SolverOptions options;
   options.implicit.newtonTolerance = newtonTolerance;
   options.implicit.newtonPositionTolerance = newtonTolerance * 1e-2;
+  // The clamped Hessian converges linearly on this compressed-and-stretched cube: about 12
+  // iterations to 1e-11, more to 1e-13.
+  options.implicit.newtonMaxIterations = 200;
   Simulation sim(buildWorld(spec), kind, 0.01, options);
   const Eigen::Vector3d L0 = angularMomentum(sim.model(), sim.state());
   for (int i = 0; i < 20; ++i) EXPECT_TRUE(sim.step().ok) << integratorName(kind);
+  for (const Statistic& stat : sim.integrator().statistics()) {
+    if (stat.name == "newton_unconverged_steps") {
+      EXPECT_EQ(stat.value, 0.0) << integratorName(kind);
+    }
+  }
   return angularMomentum(sim.model(), sim.state()).dot(L0) / L0.squaredNorm();
 }
 
@@ -64,19 +73,27 @@ TEST(NewtonIntegrators, KeepTheAngularMomentumOfASpinningStretchedCube) {
     SCOPED_TRACE("k " + std::to_string(k));
     const double implicit = angularMomentumKept(IntegratorKind::Implicit, k);
     EXPECT_GE(implicit, 0.97);
-    // Midpoint conserves it exactly for central forces, up to Newton's residual: 5e-9 (k = 1e4)
-    // and 1.7e-8 (k = 1e5) at a relative residual of 1e-13, where round-off in forces of
-    // hundreds of newtons sets the floor; backward Euler loses 2.5% in its first step.
-    EXPECT_NEAR(angularMomentumKept(IntegratorKind::Midpoint, k, 1e-13), 1.0, 1e-7);
-    // BDF2's backward-Euler start costs 2.5%, of which it gives some back (measured 98.7%).
-    EXPECT_GE(angularMomentumKept(IntegratorKind::Bdf2, k), 0.98);
+    // Midpoint conserves it exactly for central forces, up to Newton's residual: measured
+    // 1e-13 at a relative residual of 1e-13 (5e-8 at 1e-10, 2e-10 at 1e-12); backward Euler
+    // loses 2.5% in its first step.
+    EXPECT_NEAR(angularMomentumKept(IntegratorKind::Midpoint, k, 1e-13), 1.0, 1e-9);
+    // BDF2's backward-Euler start costs 2.5%, of which it gives some back: measured 98.74% at
+    // both k, short of the 99% asked (solvers/newton_integrators.h: what second-order starts
+    // do instead). Asserted to the measured figure, so a loss that grows fails.
+    const double bdf2 = angularMomentumKept(IntegratorKind::Bdf2, k);
+    std::printf("at k = %g: bdf2 keeps %.5f of the angular momentum\n", k, bdf2);
+    EXPECT_GE(bdf2, 0.987);
+    EXPECT_LE(bdf2, 1.001);
     // The linearized step pins the rotation (src/PHYSICS.md), and the trapezoidal rule
-    // (newmark) gains energy on this stiff nonlinear problem: both measured and printed.
+    // (newmark) gains on this stiff nonlinear problem: both measured and printed.
     const double linear = angularMomentumKept(IntegratorKind::ImplicitLinear, k);
     const double newmark = angularMomentumKept(IntegratorKind::Newmark, k);
     std::printf("at k = %g: implicit-linear keeps %.4f of the angular momentum, newmark %.4f\n", k,
                 linear, newmark);
     EXPECT_LT(linear, 0.1);
+    // Converged, the trapezoidal rule keeps it all and more: it gains (measured 1.39 at
+    // k = 1e4, 1.008 at 1e5), the energy drift of the trapezoidal rule on nonlinear springs.
+    EXPECT_GE(newmark, 0.99);
   }
 }
 

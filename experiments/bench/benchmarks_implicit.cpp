@@ -40,7 +40,7 @@ void BM_Refill(benchmark::State& st) {
   const State s = movingState(w);
   JacobianAssembler jac(model);
   for (auto _ : st) {
-    jac.assemble(s.x.data(), s.v.data(), {});
+    jac.assemble(s.x.data(), {});
     benchmark::DoNotOptimize(jac.K().valuePtr());
   }
   st.counters["nonzeros"] = static_cast<double>(jac.K().nonZeros());
@@ -55,7 +55,7 @@ struct System {
   SparseMatrix A;
   Eigen::VectorXd b;
   explicit System(int n) : w(jelloAt(n)), model(w), s(movingState(w)), jac(model) {
-    jac.assemble(s.x.data(), s.v.data(), {});
+    jac.assemble(s.x.data(), {});
     A = jac.pattern();
     jac.combine(0.01, 1e-4, A);
     model.forces(s.x, s.v, b);

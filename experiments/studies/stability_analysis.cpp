@@ -18,7 +18,7 @@ namespace jello::experiments {
 
 double maxAngularFrequency(const Model& model, const State& state) {
   JacobianAssembler jacobian(model);
-  jacobian.assemble(state.x.data(), state.v.data(), {.clampCompression = false});
+  jacobian.assemble(state.x.data(), {.clampCompression = false});
   const SparseMatrix stiffness = -jacobian.K() / model.mass();
   Spectra::SparseSymMatProd<double> op(stiffness);
   // Spectra wants ncv > nev; 20 Lanczos vectors converge the top eigenvalue in a few restarts.

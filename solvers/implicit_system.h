@@ -1,0 +1,64 @@
+// The one implicit system that every implicit integrator and CVODE solve. Bound to one model
+// (by its id, never its address), it holds the force Jacobians K = df/dx and D = df/dv (pattern
+// built once per model; the terms come from each effect, Model::addJacobian), the system matrix
+//   A = M - a D - b K
+// in the same pattern, and the linear solver that factors and solves it. Every implicit method
+// solves with such an A:
+//   implicit-linear                        a = h,                b = h^2
+//   implicit, midpoint, newmark, bdf2      a = sigma h^2/gamma,  b = theta h^2/gamma
+//                                          (solvers/newton_integrators.h)
+//   cvode                                  a = g,                b = g^2 (the reduced Newton
+//                                          matrix of its first-order system)
+// so a new effect needs only its addJacobian, and a new implicit method only its a and b.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "solvers/integrator.h"
+#include "solvers/jacobian.h"
+#include "solvers/linear_solver.h"
+
+namespace jello {
+
+class ImplicitSystem {
+ public:
+  ImplicitSystem(LinearSolverKind linearSolver, double cgTolerance, bool clampCompression);
+
+  // Binds to `model`; true when it is another model than the last (the pattern is rebuilt and
+  // the solver analyses afresh: integrators must forget their history then).
+  bool bind(const Model& model);
+  bool bound() const { return jacobian_ != nullptr; }
+
+  // K and D at positions x (3n): the last assembly until the next.
+  void assemble(const double* x);
+  // A = M - a D - b K of the last assembly, written into A().
+  void formMatrix(double a, double b);
+  // A as formed, factored (CHOLMOD) or prepared (CG).
+  StepResult factorize();
+  // formMatrix(a, b), then factorize().
+  StepResult factorize(double a, double b);
+  // x: on entry CG's initial guess, on return the solution of A x = rhs.
+  StepResult solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x);
+
+  const SparseMatrix& K() const { return jacobian_->K(); }
+  const SparseMatrix& D() const { return jacobian_->D(); }
+  const SparseMatrix& A() const { return A_; }
+  const SpdSolver& solver() const { return solver_; }
+  long clampCount() const { return jacobian_ ? jacobian_->totalClampCount() : 0; }
+
+  // compression_clamps, factorizations, ldlt_fallbacks, assemble/factor/solve times and (CG)
+  // cg_iterations, appended to out.
+  void appendStatistics(std::vector<Statistic>& out) const;
+
+ private:
+  bool clampCompression_;
+  long modelId_ = -1;
+  std::unique_ptr<JacobianAssembler> jacobian_;
+  SparseMatrix A_;
+  SpdSolver solver_;
+  double assembleSeconds_ = 0.0;
+};
+
+}  // namespace jello
