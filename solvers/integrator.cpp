@@ -4,6 +4,7 @@
 #include "solvers/explicit_integrators.h"
 #include "solvers/linearized_backward_euler.h"
 #include "solvers/newton_integrators.h"
+#include "solvers/projective_integrator.h"
 
 namespace jello {
 

@@ -33,9 +33,15 @@ struct CvodeOptions {
   double cgTolerance = 1e-6;
 };
 
+struct ProjectiveOptions {
+  int iterations = 10;     // local/global iterations per step
+  double tolerance = 0.0;  // m: stop when an update moves no coordinate more (0: never early)
+};
+
 struct SolverOptions {
   ImplicitOptions implicit;
   CvodeOptions cvode;
+  ProjectiveOptions projective;
 };
 
 }  // namespace jello

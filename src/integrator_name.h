@@ -28,7 +28,9 @@ namespace jello {
     "implicit midpoint: symplectic, second order, no artificial damping")                 \
   X(Newmark, "newmark", "newmark", Newmark,                                               \
     "average-acceleration Newmark (trapezoidal rule): second order, A-stable")            \
-  X(Bdf2, "bdf2", "bdf2", Bdf2, "second-order BDF, started by backward Euler")
+  X(Bdf2, "bdf2", "bdf2", Bdf2, "second-order BDF, started by backward Euler")            \
+  X(Projective, "projective", "projective", ProjectiveIntegrator,                         \
+    "backward Euler by prefactored local/global iterations (projective dynamics)")
 
 enum class IntegratorKind {
 #define JELLO_INTEGRATOR_ENUMERATOR(kind, name, fileName, Class, summary) kind,

@@ -130,6 +130,10 @@ TEST_P(HardCaseTest, Bdf2StaysStable) {
   expectStableForTwoSeconds(GetParam(), IntegratorKind::Bdf2, {});
 }
 
+TEST_P(HardCaseTest, ProjectiveStaysStable) {
+  expectStableForTwoSeconds(GetParam(), IntegratorKind::Projective, {});
+}
+
 TEST_P(HardCaseTest, CvodeStaysStable) {
   SolverOptions options;
   options.cvode.rtol = 1e-3;

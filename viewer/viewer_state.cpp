@@ -1,5 +1,6 @@
 #include "viewer/viewer_state.h"
 
+#include <array>
 #include <cmath>
 #include <sstream>
 #include <vector>
@@ -10,8 +11,16 @@ namespace jello::viewer {
 
 KeyResult handleKey(ViewerState& s, unsigned char key) {
   const auto integrators = allIntegrators();
-  if (key >= '1' && key < '1' + integrators.size()) {
-    return {Command::SwitchIntegrator, integrators[key - '1']};
+  // Keys 1-9, then 0 for the tenth.
+  static_assert(std::size(std::array{
+#define JELLO_INTEGRATOR_ROW(kind, name, fileName, Class, summary) 0,
+                    JELLO_INTEGRATORS(JELLO_INTEGRATOR_ROW)
+#undef JELLO_INTEGRATOR_ROW
+                }) <= 10,
+                "the number keys reach ten integrators");
+  const std::size_t index = key == '0' ? 9 : static_cast<std::size_t>(key - '1');
+  if (key >= '0' && key <= '9' && index < integrators.size()) {
+    return {Command::SwitchIntegrator, integrators[index]};
   }
   switch (key) {
     case 27:
@@ -81,10 +90,12 @@ KeyBinding integratorKeys() {
   const auto integrators = allIntegrators();
   std::string action = "integrator:";
   for (std::size_t i = 0; i < integrators.size(); ++i) {
-    action += (i ? ", " : " ") + std::to_string(i + 1) + " " +
+    action += (i ? ", " : " ") + std::to_string((i + 1) % 10) + " " +
               std::string(integratorName(integrators[i]));
   }
-  return {"1-" + std::to_string(integrators.size()), action + " (same state)"};
+  const std::string keys =
+      integrators.size() <= 9 ? "1-" + std::to_string(integrators.size()) : std::string("1-9, 0");
+  return {keys, action + " (same state)"};
 }
 
 }  // namespace

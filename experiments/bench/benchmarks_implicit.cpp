@@ -7,6 +7,12 @@
 //   BM_CvodeOneSecond/<rtol>    jello.w for 1 simulated second (counters: CVODE statistics)
 //   BM_StiffOneSecond/<method>/E  stiffCube(10^E) for 1 simulated second: implicit at
 //                               dt = 0.01 against RK4 at its largest stable dt (bisection)
+//   BM_ImplicitIntegratorStep/<integrator>/N/spinning  one step at dt = 0.01 (projective: 10
+//                               iterations; also at N = 32 on jello.w)
+//   BM_Crossover/<method>/E     1 simulated second of the spinning stretched cube at k = 10^E
+//                               with damping 0.25 (8^3): projective at dt = 1/60, implicit and
+//                               bdf2 at dt = 0.01, RK4 at 0.9 of its measured stability limit;
+//                               the time is wall time per simulated second
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -145,6 +151,11 @@ JELLO_IMPLICIT_STEP_BENCHMARK(implicit_linear, IntegratorKind::ImplicitLinear);
 JELLO_IMPLICIT_STEP_BENCHMARK(midpoint, IntegratorKind::Midpoint);
 JELLO_IMPLICIT_STEP_BENCHMARK(newmark, IntegratorKind::Newmark);
 JELLO_IMPLICIT_STEP_BENCHMARK(bdf2, IntegratorKind::Bdf2);
+JELLO_IMPLICIT_STEP_BENCHMARK(projective, IntegratorKind::Projective);
+BENCHMARK_CAPTURE(BM_ImplicitIntegratorStep, projective, IntegratorKind::Projective)
+    ->Args({32, 0})
+    ->ArgNames({"N", "spinning"})
+    ->Unit(benchmark::kMillisecond);
 
 // Runs `sim` to t = 1 s; false if it diverged.
 bool runOneSecond(Simulation& sim) {
@@ -180,7 +191,7 @@ BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e6_cg, 1e-6, LinearSolverKind::Cg)
 
 // The largest dt at which RK4 runs the stiff cube for 0.1 s without diverging (bisection to
 // 1%), then 5% below it for safety over the full second.
-double largestStableRk4Step(const World& w) {
+double largestStableRk4Step(const World& w, double margin = 0.95) {
   double stable = 1e-6, unstable = 1e-2;
   while (unstable / stable > 1.01) {
     const double dt = std::sqrt(stable * unstable);
@@ -189,7 +200,7 @@ double largestStableRk4Step(const World& w) {
     for (long i = 0; ok && i < std::lround(0.1 / dt); ++i) ok = sim.step().ok;
     (ok ? stable : unstable) = dt;
   }
-  return 0.95 * stable;
+  return margin * stable;
 }
 
 void BM_StiffOneSecond(benchmark::State& st, IntegratorKind kind, LinearSolverKind solver) {
@@ -221,5 +232,27 @@ BENCHMARK_CAPTURE(BM_StiffOneSecond, implicit_cg_dt001, IntegratorKind::Implicit
     ->Arg(6)
     ->Iterations(3)
     ->Unit(benchmark::kMillisecond);
+
+void BM_Crossover(benchmark::State& st, IntegratorKind kind) {
+  const World w = buildWorld(vibratingStiffCube(std::pow(10.0, static_cast<double>(st.range(0)))));
+  double dt = 0.01;
+  if (kind == IntegratorKind::Projective) dt = 1.0 / 60.0;
+  if (kind == IntegratorKind::RK4) dt = largestStableRk4Step(w, 0.9);
+  for (auto _ : st) {
+    Simulation sim(w, kind, dt);
+    if (!runOneSecond(sim)) st.SkipWithError("diverged");
+  }
+  st.counters["dt_s"] = dt;
+}
+#define JELLO_CROSSOVER_BENCHMARK(name, kind) \
+  BENCHMARK_CAPTURE(BM_Crossover, name, kind) \
+      ->Arg(4)                                \
+      ->Arg(5)                                \
+      ->Iterations(3)                         \
+      ->Unit(benchmark::kMillisecond)
+JELLO_CROSSOVER_BENCHMARK(rk4, IntegratorKind::RK4);
+JELLO_CROSSOVER_BENCHMARK(projective, IntegratorKind::Projective);
+JELLO_CROSSOVER_BENCHMARK(implicit, IntegratorKind::Implicit);
+JELLO_CROSSOVER_BENCHMARK(bdf2, IntegratorKind::Bdf2);
 
 }  // namespace

@@ -297,6 +297,18 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str()
       ->group(implicitGroup);
+  auto& projective = opt.solver.projective;
+  app.add_option("--projective-iters", projective.iterations,
+                 "projective: local/global iterations per step")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str()
+      ->group(implicitGroup);
+  app.add_option("--projective-tol", projective.tolerance,
+                 "projective: stop a step's iterations early once an update moves no coordinate "
+                 "more than this (m; 0: never early)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str()
+      ->group(implicitGroup);
   app.add_option("--rtol", cvode.rtol, "cvode: relative tolerance")
       ->check(CLI::PositiveNumber)
       ->capture_default_str()
