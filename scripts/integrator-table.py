@@ -10,10 +10,15 @@ with a JSON sidecar. With --readme it also rewrites the table in README.md betwe
     scripts/integrator-table.py [--readme] [--no-run] [--bin build/release/bin]
 
 The second README table, the cost of one step of each implicit integrator, comes from
-experiments/results/implicit_steps.json, which Google Benchmark writes:
+experiments/results/implicit_steps.json, and the third, wall time per simulated second against
+RK4 (projective's crossover), from experiments/results/crossover.json; Google Benchmark writes
+both:
     OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 0 build/release/bin/benchmarks \
       --benchmark_filter=ImplicitIntegratorStep --benchmark_min_time=0.2 \
       --benchmark_out=experiments/results/implicit_steps.json --benchmark_out_format=json
+    OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 0 build/release/bin/benchmarks \
+      --benchmark_filter=Crossover \
+      --benchmark_out=experiments/results/crossover.json --benchmark_out_format=json
 """
 import argparse
 import csv
@@ -34,6 +39,8 @@ BEGIN, END = "<!-- integrators-table:begin -->", "<!-- integrators-table:end -->
 # Google Benchmark's JSON of BM_ImplicitIntegratorStep (see --steps-json), and its README table.
 STEPS_JSON = os.path.join(ROOT, "experiments", "results", "implicit_steps.json")
 STEPS_BEGIN, STEPS_END = "<!-- implicit-steps:begin -->", "<!-- implicit-steps:end -->"
+CROSSOVER_JSON = os.path.join(ROOT, "experiments", "results", "crossover.json")
+CROSSOVER_BEGIN, CROSSOVER_END = "<!-- crossover:begin -->", "<!-- crossover:end -->"
 
 # integrator, dt (s), extra jello-sim arguments
 RUNS = [
@@ -44,6 +51,7 @@ RUNS = [
     ("newmark", 0.01, []),
     ("bdf2", 0.01, []),
     ("cvode", 0.01, ["--rtol", "1e-6"]),
+    ("projective", 0.01, []),
 ]
 COLUMNS = ["integrator", "dt_s", "simulated_s", "steps", "energy_start_J", "energy_end_J",
            "energy_kept", "angular_momentum_kept", "wall_time_s", "wall_time_per_step_ms",
@@ -130,6 +138,45 @@ def steps_table_from_json():
     return "\n".join(lines)
 
 
+def milliseconds(b):
+    return b["real_time"] * {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[b["time_unit"]]
+
+
+def duration(ms):
+    return f"{ms:.3g} ms" if ms < 1000 else f"{ms / 1e3:.3g} s"
+
+
+def crossover_table_from_json():
+    """Wall time per simulated second (BM_Crossover/<method>/<E>, k = 10^E) and each method's
+    speed-up over RK4 measured in the same run."""
+    with open(CROSSOVER_JSON) as f:
+        data = json.load(f)
+    cells, order, exponents = {}, [], []
+    for b in data["benchmarks"]:
+        if b.get("run_type") == "aggregate":
+            continue
+        _, method, exponent = b["name"].split("/")[:3]
+        method = method.replace("_", "-")
+        if method not in order:
+            order.append(method)
+        if exponent not in exponents:
+            exponents.append(exponent)
+        cells[(method, exponent)] = (milliseconds(b), b["dt_s"])
+    lines = ["| integrator | " + " | ".join(f"k = 1e{e}: per simulated second (dt)"
+                                            for e in exponents) +
+             " | " + " | ".join(f"speed-up over RK4 at 1e{e}" for e in exponents) + " |",
+             "|---|" + "---|" * (2 * len(exponents))]
+    for method in order:
+        row = [f"`{method}`"]
+        for e in exponents:
+            ms, dt = cells[(method, e)]
+            row.append(f"{duration(ms)} ({dt:.3g} s)")
+        for e in exponents:
+            row.append(f"{cells[('rk4', e)][0] / cells[(method, e)][0]:.2g}x")
+        lines.append("| " + " | ".join(row) + " |")
+    return "\n".join(lines)
+
+
 def replace_between(text, begin, end, body):
     if begin not in text or end not in text:
         sys.exit(f"integrator-table: README.md has no {begin} marker")
@@ -177,6 +224,7 @@ def main():
             text = f.read()
         text = replace_between(text, BEGIN, END, table_from_csv())
         text = replace_between(text, STEPS_BEGIN, STEPS_END, steps_table_from_json())
+        text = replace_between(text, CROSSOVER_BEGIN, CROSSOVER_END, crossover_table_from_json())
         write_atomically(README, text)
 
 
