@@ -2,9 +2,11 @@
 
 #include <cvode/cvode_ls.h>
 #include <nvector/nvector_serial.h>
+#include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <string>
 
 namespace jello {
@@ -16,6 +18,10 @@ CvodeIntegrator& self(void* data) {
 
 int rhsTrampoline(sunrealtype, N_Vector y, N_Vector ydot, void* data) {
   return self(data).rightHandSide(N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
+}
+
+int rootTrampoline(sunrealtype, N_Vector y, sunrealtype* g, void* data) {
+  return self(data).contactDepths(N_VGetArrayPointer(y), g);
 }
 
 int linsysTrampoline(sunrealtype, N_Vector y, N_Vector, SUNMatrix, sunbooleantype jok,
@@ -69,9 +75,11 @@ CvodeIntegrator::CvodeIntegrator(CvodeOptions options)
       system_(options.linearSolver, options.cgTolerance, options.clampCompression) {}
 
 CvodeIntegrator::~CvodeIntegrator() {
-  // CVODE first (it refers to the solver, matrix and vector), the context last.
+  // CVODE first (it refers to the solvers, matrix and vectors), the context last.
   cvode_.reset();
   linearSolver_.reset();
+  nonlinearSolver_.reset();
+  atol_.reset();
   matrix_.reset();
   y_.reset();
   context_.reset();
@@ -79,9 +87,7 @@ CvodeIntegrator::~CvodeIntegrator() {
 
 bool CvodeIntegrator::continues(const Model& model, const State& s) const {
   if (restartPending_ || !cvode_ || modelId_ != model.id() || s.t != t_) return false;
-  const double* y = N_VGetArrayPointer(y_.get());
-  const std::size_t bytes = static_cast<std::size_t>(n3_) * sizeof(double);
-  return std::memcmp(y, s.x.data(), bytes) == 0 && std::memcmp(y + n3_, s.v.data(), bytes) == 0;
+  return s.x == lastX_ && s.v == lastV_;
 }
 
 StepResult CvodeIntegrator::start(const Model& model, const State& s) {
@@ -90,51 +96,81 @@ StepResult CvodeIntegrator::start(const Model& model, const State& s) {
   modelId_ = model.id();
   n3_ = 3 * model.numPoints();
   if (!sameModel) {
+    carryCounters();
     cvode_.reset();
     linearSolver_.reset();
     matrix_.reset();
     y_.reset();
+    nonlinearSolver_.reset();
+    atol_.reset();
     context_.reset();
     SUNContext ctx = nullptr;
     if (SUNContext_Create(nullptr, &ctx) != 0) return StepResult::failure("SUNContext_Create");
     context_.reset(ctx);
     y_.reset(N_VNew_Serial(2 * n3_, ctx));
-    if (!y_) return StepResult::failure("N_VNew_Serial failed");
+    atol_.reset(N_VNew_Serial(2 * n3_, ctx));
+    if (!y_ || !atol_) return StepResult::failure("N_VNew_Serial failed");
     // A new model: the system rebuilds its pattern and its solver analyses afresh.
     system_.bind(model);
     b_.setZero(n3_);
   }
+  // Positions relative to the centre of mass of the start.
+  const int n = n3_ / 3;
+  shift_.resize(n3_);
+  for (int c = 0; c < 3; ++c) shift_.segment(c * n, n).setConstant(s.x.segment(c * n, n).mean());
   double* y = N_VGetArrayPointer(y_.get());
-  std::memcpy(y, s.x.data(), static_cast<std::size_t>(n3_) * sizeof(double));
-  std::memcpy(y + n3_, s.v.data(), static_cast<std::size_t>(n3_) * sizeof(double));
+  Eigen::Map<Eigen::VectorXd>(y, n3_) = s.x - shift_;
+  Eigen::Map<Eigen::VectorXd>(y + n3_, n3_) = s.v;
+  lastX_ = s.x;
+  lastV_ = s.v;
   t_ = s.t;
   assembled_ = false;
   restartPending_ = false;
   ++restarts_;
 
   if (sameModel) {
+    carryCounters();
     if (int f = CVodeReInit(cvode_.get(), s.t, y_.get()); f != CV_SUCCESS) {
       return StepResult::failure(cvodeError("CVodeReInit", f));
     }
     return StepResult::success();
   }
-  cvode_.reset(CVodeCreate(CV_BDF, context_.get()));
+  const bool adams = options_.method == CvodeMethod::Adams;
+  cvode_.reset(CVodeCreate(adams ? CV_ADAMS : CV_BDF, context_.get()));
   if (!cvode_) return StepResult::failure("CVodeCreate failed");
   void* mem = cvode_.get();
-  const double atol = options_.atol > 0.0 ? options_.atol : 1e-3 * options_.rtol;
+  const double fallback = 1e-3 * options_.rtol;
+  double* atol = N_VGetArrayPointer(atol_.get());
+  std::fill(atol, atol + n3_, options_.atolPosition > 0.0 ? options_.atolPosition : fallback);
+  std::fill(atol + n3_, atol + 2 * n3_,
+            options_.atolVelocity > 0.0 ? options_.atolVelocity : fallback);
   auto check = [](const char* call, int flag) {
     return flag == CV_SUCCESS ? StepResult::success() : StepResult::failure(cvodeError(call, flag));
   };
   for (const StepResult& r :
        {check("CVodeInit", CVodeInit(mem, rhsTrampoline, s.t, y_.get())),
-        check("CVodeSStolerances", CVodeSStolerances(mem, options_.rtol, atol)),
+        check("CVodeSVtolerances", CVodeSVtolerances(mem, options_.rtol, atol_.get())),
         check("CVodeSetUserData", CVodeSetUserData(mem, this)),
         check("CVodeSetMaxNumSteps", CVodeSetMaxNumSteps(mem, options_.maxStepsPerCall)),
         check("CVodeSetMaxOrd", CVodeSetMaxOrd(mem, options_.maxOrder)),
-        check("CVodeSetStabLimDet",
-              CVodeSetStabLimDet(mem, options_.stabilityLimitDetection ? SUNTRUE : SUNFALSE)),
         check("CVodeSetMaxStep", CVodeSetMaxStep(mem, options_.maxStep))}) {
     if (!r.ok) return r;
+  }
+  if (!adams) {  // BDF only: CVODE refuses it for Adams
+    const int flag = CVodeSetStabLimDet(mem, options_.stabilityLimitDetection ? SUNTRUE : SUNFALSE);
+    if (StepResult r = check("CVodeSetStabLimDet", flag); !r.ok) return r;
+  }
+  if (options_.contactRoots && numRootFunctions() > 0) {
+    if (StepResult r =
+            check("CVodeRootInit", CVodeRootInit(mem, numRootFunctions(), rootTrampoline));
+        !r.ok) {
+      return r;
+    }
+  }
+  if (adams) {
+    nonlinearSolver_.reset(SUNNonlinSol_FixedPoint(y_.get(), 0, context_.get()));
+    if (!nonlinearSolver_) return StepResult::failure("SUNNonlinSol_FixedPoint failed");
+    return check("CVodeSetNonlinearSolver", CVodeSetNonlinearSolver(mem, nonlinearSolver_.get()));
   }
 
   SUNMatrix A = SUNMatNewEmpty(context_.get());
@@ -162,20 +198,34 @@ StepResult CvodeIntegrator::step(const Model& model, State& s, double h) {
   if (!continues(model, s)) {
     if (StepResult r = start(model, s); !r.ok) return r;
   }
+  const double tout = s.t + h;
   sunrealtype reached = s.t;
-  const int flag = CVode(cvode_.get(), s.t + h, y_.get(), &reached, CV_NORMAL);
-  if (flag < 0) return StepResult::failure(cvodeError("CVode", flag));
+  for (;;) {
+    const int flag = CVode(cvode_.get(), tout, y_.get(), &reached, CV_NORMAL);
+    if (flag < 0) return StepResult::failure(cvodeError("CVode", flag));
+    if (flag != CV_ROOT_RETURN || reached >= tout) break;
+    // A contact began or ended at `reached`: the force's derivative jumps there, so the
+    // history of the multistep method is restarted from the located state.
+    ++roots_;
+    carryCounters();
+    if (int f = CVodeReInit(cvode_.get(), reached, y_.get()); f != CV_SUCCESS) {
+      return StepResult::failure(cvodeError("CVodeReInit", f));
+    }
+  }
   const double* y = N_VGetArrayPointer(y_.get());
-  std::memcpy(s.x.data(), y, static_cast<std::size_t>(n3_) * sizeof(double));
-  std::memcpy(s.v.data(), y + n3_, static_cast<std::size_t>(n3_) * sizeof(double));
+  s.x = Eigen::Map<const Eigen::VectorXd>(y, n3_) + shift_;
+  s.v = Eigen::Map<const Eigen::VectorXd>(y + n3_, n3_);
   s.t = reached;
   t_ = reached;
+  lastX_ = s.x;
+  lastV_ = s.v;
   return StepResult::success();
 }
 
 int CvodeIntegrator::rightHandSide(const double* y, double* ydot) {
   std::memcpy(ydot, y + n3_, static_cast<std::size_t>(n3_) * sizeof(double));
-  model_->acceleration(y, y + n3_, ydot + n3_);
+  x_ = Eigen::Map<const Eigen::VectorXd>(y, n3_) + shift_;
+  model_->acceleration(x_.data(), y + n3_, ydot + n3_);
   double sum = 0.0;
   for (int i = n3_; i < 2 * n3_; ++i) sum += ydot[i];
   return std::isfinite(sum) ? 0 : 1;  // recoverable: CVODE retries with a smaller step
@@ -184,7 +234,8 @@ int CvodeIntegrator::rightHandSide(const double* y, double* ydot) {
 int CvodeIntegrator::linearSystem(const double* y, bool jacobianOk, bool* jacobianCurrent,
                                   double gamma) {
   if (!jacobianOk || !assembled_) {
-    system_.assemble(y);
+    x_ = Eigen::Map<const Eigen::VectorXd>(y, n3_) + shift_;
+    system_.assemble(x_.data());
     assembled_ = true;
     *jacobianCurrent = true;
   }
@@ -207,24 +258,79 @@ int CvodeIntegrator::solve(const double* b, double* x) {
   return 0;
 }
 
+int CvodeIntegrator::numRootFunctions() const {
+  const int n = n3_ / 3;
+  return (model_->hasWalls() ? 3 * n : 0) + (model_->hasPlane() ? n : 0) +
+         (model_->hasSphere() ? n : 0);
+}
+
+// Penetration depths as functions that change sign where a contact begins or ends: positive
+// on the free side.
+int CvodeIntegrator::contactDepths(const double* y, double* g) {
+  const int n = n3_ / 3;
+  x_ = Eigen::Map<const Eigen::VectorXd>(y, n3_) + shift_;
+  const double* x = x_.data();
+  if (model_->hasWalls()) {
+    for (int i = 0; i < n3_; ++i) *g++ = kBoxHalfSize - std::abs(x[i]);
+  }
+  if (const auto& plane = model_->plane()) {
+    const Vec3 u = plane->normal();
+    for (int p = 0; p < n; ++p) {
+      *g++ = u.x * x[p] + u.y * x[n + p] + u.z * x[2 * n + p] + plane->offset();
+    }
+  }
+  if (const auto& sphere = model_->sphere()) {
+    const Sphere& sp = sphere->sphere();
+    for (int p = 0; p < n; ++p) {
+      *g++ = norm(Vec3{x[p], x[n + p], x[2 * n + p]} - sp.center) - sp.radius;
+    }
+  }
+  return 0;
+}
+
+namespace {
+
+// CVODE's counters, which CVodeReInit sets back to zero: the integrator carries them over.
+struct Counter {
+  const char* name;
+  int (*getter)(void*, long*);
+};
+constexpr Counter kCounters[] = {
+    {"cvode_steps", CVodeGetNumSteps},
+    {"rhs_evaluations", CVodeGetNumRhsEvals},
+    {"linear_setups", CVodeGetNumLinSolvSetups},
+    {"newton_iterations", CVodeGetNumNonlinSolvIters},
+    {"newton_convergence_failures", CVodeGetNumNonlinSolvConvFails},
+    {"error_test_failures", CVodeGetNumErrTestFails},
+};
+static_assert(std::size(kCounters) == CvodeIntegrator::kNumCounters);
+
+}  // namespace
+
+void CvodeIntegrator::carryCounters() {
+  if (!cvode_) return;
+  for (std::size_t i = 0; i < kNumCounters; ++i) {
+    long value = 0;
+    if (kCounters[i].getter(cvode_.get(), &value) == CV_SUCCESS) carried_[i] += value;
+  }
+}
+
 std::vector<Statistic> CvodeIntegrator::statistics() const {
   std::vector<Statistic> stats;
   if (!cvode_) return stats;
   void* mem = cvode_.get();
-  // Each getter's flag is checked; a figure whose getter fails is left out.
-  auto add = [&](const char* name, int (*getter)(void*, long*)) {
+  // Each getter's flag is checked; a figure whose getter fails is left out. The counts of
+  // earlier starts (restarts, contact roots) are added.
+  for (std::size_t i = 0; i < kNumCounters; ++i) {
     long value = 0;
-    if (getter(mem, &value) == CV_SUCCESS) stats.push_back({name, static_cast<double>(value)});
-  };
-  add("cvode_steps", CVodeGetNumSteps);
-  add("rhs_evaluations", CVodeGetNumRhsEvals);
-  add("linear_setups", CVodeGetNumLinSolvSetups);
-  add("newton_iterations", CVodeGetNumNonlinSolvIters);
-  add("newton_convergence_failures", CVodeGetNumNonlinSolvConvFails);
-  add("error_test_failures", CVodeGetNumErrTestFails);
+    if (kCounters[i].getter(mem, &value) == CV_SUCCESS) {
+      stats.push_back({kCounters[i].name, static_cast<double>(value + carried_[i])});
+    }
+  }
   int order = 0;
   if (CVodeGetLastOrder(mem, &order) == CV_SUCCESS) stats.push_back({"last_order", double(order)});
   stats.push_back({"starts", double(restarts_)});  // 1 + restarts from a state set outside
+  if (options_.contactRoots) stats.push_back({"contact_roots", double(roots_)});
   system_.appendStatistics(stats);
   return stats;
 }

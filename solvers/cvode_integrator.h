@@ -7,8 +7,17 @@
 // custom linear solver of DIRECT type, so CVODE keeps its own heuristics for when to refresh
 // the Jacobian and refactor, and its correction for a changed g. One step() call advances the
 // state to t + h (an output interval), CVODE choosing its own internal steps.
+// Method adams: Adams-Moulton with fixed-point iterations (SUNNonlinSol_FixedPoint), for the
+// non-stiff regime: no Jacobian, no linear solves.
+// CVODE integrates the positions relative to the cube's centre of mass at the start (so its
+// relative tolerance does not depend on where the scene is), with separate absolute
+// tolerances for positions and velocities (CVodeSVtolerances). With contactRoots, the
+// penetration depths (walls: 2 - |x_i| per coordinate; plane: signed distance; sphere:
+// distance - R) are CVODE root functions: it stops where a contact begins or ends, and is
+// restarted there (CVodeReInit), as the force's derivative jumps.
 #pragma once
 
+#include <array>
 #include <memory>
 
 #include "solvers/implicit_system.h"
@@ -33,10 +42,16 @@ class CvodeIntegrator final : public Integrator {
   int linearSystem(const double* y, bool jacobianOk, bool* jacobianCurrent, double gamma);
   int setupSolver();
   int solve(const double* b, double* x);
+  int contactDepths(const double* y, double* g);
+  int numRootFunctions() const;
+
+  static constexpr std::size_t kNumCounters = 6;
 
  private:
   StepResult start(const Model& model, const State& state);
   bool continues(const Model& model, const State& state) const;
+  // Adds CVODE's counters to carried_ before CVodeReInit or a new CVODE zeroes them.
+  void carryCounters();
 
   CvodeOptions options_;
   const Model* model_ = nullptr;  // for the callbacks, during a step
@@ -46,13 +61,19 @@ class CvodeIntegrator final : public Integrator {
   sundials::Vector y_;
   sundials::Matrix matrix_;
   sundials::LinearSolver linearSolver_;
+  sundials::NonlinearSolver nonlinearSolver_;  // adams: fixed point
+  sundials::Vector atol_;
   sundials::CvodeMemory cvode_;
   ImplicitSystem system_;
   double gamma_ = 0.0;  // of the matrix last formed
   bool assembled_ = false;
   Eigen::VectorXd rhs_, b_;
-  double t_ = 0.0;  // CVODE's time, to notice a state changed from outside
-  long restarts_ = 0;
+  Eigen::VectorXd shift_;  // 3n: the start's centre of mass, added back to CVODE's positions
+  Eigen::VectorXd x_;      // 3n: absolute positions for the callbacks
+  Eigen::VectorXd lastX_, lastV_;  // the state last handed out, to notice changes from outside
+  double t_ = 0.0;                 // CVODE's time, to notice a state changed from outside
+  long restarts_ = 0, roots_ = 0;
+  std::array<long, kNumCounters> carried_{};
   bool restartPending_ = false;  // the model's forces changed from outside
 };
 

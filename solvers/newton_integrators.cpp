@@ -1,6 +1,7 @@
 #include "solvers/newton_integrators.h"
 
 #include <cmath>
+#include <limits>
 
 namespace jello {
 namespace {
@@ -36,7 +37,9 @@ NewtonIntegrator::NewtonIntegrator(const ImplicitOptions& options)
 
 void NewtonIntegrator::bind(const Model& model) {
   const bool rebinding = system_.bound();
-  if (system_.bind(model) && rebinding) restart();  // another model's history means nothing
+  if (!system_.bind(model)) return;
+  factorValid_ = false;
+  if (rebinding) restart();  // another model's history means nothing
 }
 
 // x_e, v_e, f and the residual r at displacement d; inertia = gamma/h^2.
@@ -64,10 +67,20 @@ double NewtonIntegrator::merit(const Model& model, double inertia, const Eigen::
   return e;
 }
 
-StepResult NewtonIntegrator::factorNewtonMatrix(double h) {
+StepResult NewtonIntegrator::prepareNewtonMatrix(double h, bool refactor) {
   system_.assemble(xe_.data());
   const double scale = h * h / form_.gamma;
-  return system_.factorize(form_.sigma * scale, form_.theta * scale);
+  const double a = form_.sigma * scale, b = form_.theta * scale;
+  if (!refactor && factorValid_ && a == factorA_ && b == factorB_) {
+    ++reuses_;
+    return StepResult::success();
+  }
+  factorValid_ = false;
+  if (StepResult res = system_.factorize(a, b); !res.ok) return res;
+  factorValid_ = true;
+  factorA_ = a;
+  factorB_ = b;
+  return StepResult::success();
 }
 
 StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
@@ -80,6 +93,7 @@ StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
   d_ = h * s.v;
   int iterations = 0;
   bool converged = false;
+  double previousNorm = std::numeric_limits<double>::infinity();
   for (;;) {
     evaluate(model, inertia, d_);
     if (lastResidual_ <= options_.newtonTolerance) {
@@ -91,7 +105,11 @@ StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
     // Newton: (h^2/gamma) J delta = -(h^2/gamma) r. x_e, v_e are those of d_ (evaluate).
     rhs_ = (-h * h / form.gamma) * r_;
     delta_.setZero(rhs_.size());
-    if (StepResult res = factorNewtonMatrix(h); !res.ok) return res;
+    // A stale factor that shrank the residual too little last time is renewed here.
+    const double norm = r_.norm();
+    const bool refactor = !options_.reuseFactor || norm > options_.refactorRatio * previousNorm;
+    previousNorm = norm;
+    if (StepResult res = prepareNewtonMatrix(h, refactor); !res.ok) return res;
     if (StepResult res = system_.solve(rhs_, delta_); !res.ok) return res;
     if (!delta_.allFinite()) return StepResult::failure("Newton produced a non-finite update");
     // An update this small is the answer to within it: the floor that ends the iterations at
@@ -164,6 +182,7 @@ SparseMatrix NewtonIntegrator::newtonMatrix(const Model& model, const State& sta
   system_.assemble(xe_.data());
   const double scale = h * h / form_.gamma;
   system_.formMatrix(form_.sigma * scale, form_.theta * scale);
+  factorValid_ = false;  // A now differs from what was factored
   return system_.A() * (form_.gamma / (h * h));
 }
 
@@ -175,6 +194,7 @@ std::vector<Statistic> NewtonIntegrator::statistics() const {
       {"newton_unconverged_steps", static_cast<double>(unconverged_)},
       {"line_search_cuts", static_cast<double>(cuts_)},
       {"line_search_failures", static_cast<double>(searchFailures_)},
+      {"factor_reuses", static_cast<double>(reuses_)},
   };
   system_.appendStatistics(stats);
   return stats;

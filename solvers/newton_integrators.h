@@ -20,6 +20,12 @@
 //             backward-Euler start keeps 98.74%, its first step costing 2.5%.)
 // Newton: J = dr/dy = gamma/h^2 M - theta K - sigma D, solved as
 //   (M - (sigma h^2/gamma) D - (theta h^2/gamma) K) delta = -(h^2/gamma) r
+// By default the factorization of that matrix is kept across iterations and steps (modified
+// Newton) and renewed only when an iteration shrinks the residual by less than refactorRatio,
+// or when h, the method's coefficients or the model change: any SPD matrix gives a descent
+// direction of the merit below, so the line search and the stopping tests are unchanged and
+// the converged step is the same (tested); K and D are still assembled at every iterate for
+// the merit's damping term.
 // with K's springs projected to semidefinite (the compression clamp), so the matrix is SPD and
 // delta a descent direction of the step's merit function
 //   E_k(y) = gamma/(2h^2) |y - y_pred|_M^2 + (U(x_e) - F_k . x_e)/theta + Psi_k(v_e)/sigma,
@@ -88,11 +94,15 @@ class NewtonIntegrator : public Integrator {
   // inertia = gamma/h^2; all three work on form_.
   void evaluate(const Model& model, double inertia, const Eigen::VectorXd& d);
   double merit(const Model& model, double inertia, const Eigen::VectorXd& d);
-  // Assembles at the iterate and factors A = M - (sigma h^2/gamma) D - (theta h^2/gamma) K.
-  StepResult factorNewtonMatrix(double h);
+  // Assembles K and D at the iterate and, when `refactor`, factors
+  // A = M - (sigma h^2/gamma) D - (theta h^2/gamma) K there.
+  StepResult prepareNewtonMatrix(double h, bool refactor);
 
   ImplicitOptions options_;
   ImplicitSystem system_;
+  // The factor in the system: valid for these coefficients a, b of A until the model changes.
+  bool factorValid_ = false;
+  double factorA_ = 0.0, factorB_ = 0.0;
   // Workspaces: positions and velocities where forces are evaluated, force, residual, update.
   ImplicitStepForm form_;  // the current step's
   Eigen::VectorXd d_, dTrial_, xe_, ve_, f_, r_, rhs_, delta_, trial_, external_, dv_;
@@ -100,7 +110,7 @@ class NewtonIntegrator : public Integrator {
   double lastResidual_ = 0.0;
   bool lastConverged_ = true;
   long steps_ = 0, iterations_ = 0, maxIterations_ = 0, cuts_ = 0, searchFailures_ = 0,
-       unconverged_ = 0;
+       unconverged_ = 0, reuses_ = 0;
 };
 
 // The four methods state only their forms; construction is the base's (ImplicitOptions or

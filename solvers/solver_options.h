@@ -12,6 +12,11 @@ struct ImplicitOptions {
   double newtonTolerance = 1e-8;          // relative residual that ends the iterations
   double newtonPositionTolerance = 1e-8;  // m: a full Newton update this small ends them too
   int lineSearchMaxCuts = 12;  // halvings of the Newton update; none descends: the whole step
+  // Modified Newton: keep the factorization across iterations and steps, and factor afresh only
+  // when an iteration shrank the residual by less than refactorRatio (or h, the method's
+  // coefficients or the model changed). The converged step is the same; only the cost changes.
+  bool reuseFactor = true;
+  double refactorRatio = 0.5;
   // implicit-linear (one solve per step): a step during which a contact begins is not near its
   // linearization (the penalty spring was not in the matrix), so it gets up to this many
   // Newton iterations, to this relative residual: the penalty must act, that's all.
@@ -21,10 +26,23 @@ struct ImplicitOptions {
   double cgTolerance = 1e-6;     // relative residual of the CG solves
 };
 
+enum class CvodeMethod {
+  Bdf,    // stiff: BDF with Newton iterations over the implicit system
+  Adams,  // non-stiff: Adams-Moulton with fixed-point iterations, no linear algebra
+};
+
 struct CvodeOptions {
+  CvodeMethod method = CvodeMethod::Bdf;
   double rtol = 1e-6;
-  double atol = 0.0;  // 0: 1e-3 * rtol (positions in m, velocities in m/s)
-  int maxOrder = 5;   // BDF order limit, 1..5 (3..5 are not A-stable)
+  // Absolute tolerances, positions (m) and velocities (m/s); 0: 1e-3 * rtol. The positions are
+  // those relative to the cube's centre of mass at the start, so translating a scene does not
+  // change the answer.
+  double atolPosition = 0.0;
+  double atolVelocity = 0.0;
+  int maxOrder = 5;  // order limit, 1..5 (BDF 3..5 are not A-stable)
+  // Contact onset and release located as roots of the penetration depths (walls, plane,
+  // sphere): CVODE stops there and restarts, instead of stepping over the force's kink.
+  bool contactRoots = false;
   bool stabilityLimitDetection = true;
   double maxStep = 0.0;            // s, 0: no limit
   long maxStepsPerCall = 1000000;  // internal steps CVODE may take to reach one output time

@@ -6,6 +6,7 @@
 #include <sundials/sundials_context.h>
 #include <sundials/sundials_linearsolver.h>
 #include <sundials/sundials_matrix.h>
+#include <sundials/sundials_nonlinearsolver.h>
 #include <sundials/sundials_nvector.h>
 
 #include <memory>
@@ -28,11 +29,16 @@ struct LinearSolverDeleter {
 struct MatrixDeleter {
   void operator()(SUNMatrix m) const { SUNMatDestroy(m); }
 };
+struct NonlinearSolverDeleter {
+  void operator()(SUNNonlinearSolver s) const { SUNNonlinSolFree(s); }
+};
 
 using Context = std::unique_ptr<std::remove_pointer_t<SUNContext>, ContextDeleter>;
 using Vector = std::unique_ptr<std::remove_pointer_t<N_Vector>, VectorDeleter>;
 using CvodeMemory = std::unique_ptr<void, CvodeDeleter>;
 using LinearSolver = std::unique_ptr<std::remove_pointer_t<SUNLinearSolver>, LinearSolverDeleter>;
 using Matrix = std::unique_ptr<std::remove_pointer_t<SUNMatrix>, MatrixDeleter>;
+using NonlinearSolver =
+    std::unique_ptr<std::remove_pointer_t<SUNNonlinearSolver>, NonlinearSolverDeleter>;
 
 }  // namespace jello::sundials

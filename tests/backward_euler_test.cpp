@@ -60,6 +60,7 @@ TEST(BackwardEuler, ConvergesWithOrderOneTowardRK4) {
 // independently of the integrator's own residual. Returns the most iterations a step needed.
 int expectExactBackwardEulerSteps(const SmallCube& cube, double tolerance) {
   ImplicitOptions options;
+  options.reuseFactor = false;  // plain Newton: a fresh Jacobian every iteration
   options.newtonMaxIterations = 30;
   options.newtonTolerance = tolerance;
   options.newtonPositionTolerance = 1e-300;  // the residual alone ends the iterations

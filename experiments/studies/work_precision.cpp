@@ -122,7 +122,7 @@ int main(int argc, char** argv) {
   std::vector<Scene> scenes;
   SolverOptions referenceOptions;
   referenceOptions.cvode.rtol = 1e-11;
-  referenceOptions.cvode.atol = 1e-14;
+  referenceOptions.cvode.atolPosition = referenceOptions.cvode.atolVelocity = 1e-14;
   referenceOptions.cvode.maxStepsPerCall = 100000000;
   try {
     // jello.w is measured at 0.04 s, before its first contact (about 0.05 s): contact onset

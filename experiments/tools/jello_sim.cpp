@@ -49,7 +49,9 @@ struct Options {
   bool quiet = false;
   jello::SolverOptions solver;
   std::string linearSolver = "cholmod";
-  bool noClamp = false, noStabLimDet = false;
+  bool noClamp = false, noStabLimDet = false, noFactorReuse = false;
+  std::string cvodeMethod = "bdf";
+  double atol = 0.0;
   jello::ReaderLimits limits;
 };
 
@@ -297,6 +299,16 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str()
       ->group(implicitGroup);
+  app.add_flag("--no-factor-reuse", opt.noFactorReuse,
+               "implicit, midpoint, newmark, bdf2: factor the Newton matrix at every iteration "
+               "(plain Newton) instead of keeping it while it converges fast enough")
+      ->group(implicitGroup);
+  app.add_option("--refactor-ratio", implicit.refactorRatio,
+                 "implicit, midpoint, newmark, bdf2: factor afresh when an iteration shrinks "
+                 "the residual by less than this")
+      ->check(CLI::Range(1e-6, 1.0))
+      ->capture_default_str()
+      ->group(implicitGroup);
   auto& projective = opt.solver.projective;
   app.add_option("--projective-iters", projective.iterations,
                  "projective: local/global iterations per step")
@@ -313,8 +325,25 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str()
       ->group(implicitGroup);
-  app.add_option("--atol", cvode.atol, "cvode: absolute tolerance (default 1e-3 * rtol)")
+  app.add_option("--cvode-method", opt.cvodeMethod,
+                 "cvode: bdf (stiff: Newton over the implicit system) or adams (non-stiff: "
+                 "fixed-point iterations, no linear algebra)")
+      ->check(CLI::IsMember({"bdf", "adams"}))
+      ->capture_default_str()
+      ->group(implicitGroup);
+  app.add_option("--atol", opt.atol,
+                 "cvode: absolute tolerance of positions (m) and velocities (m/s) (default "
+                 "1e-3 * rtol)")
       ->check(CLI::PositiveNumber)
+      ->group(implicitGroup);
+  app.add_option("--atol-x", cvode.atolPosition, "cvode: absolute tolerance of positions (m)")
+      ->check(CLI::PositiveNumber)
+      ->group(implicitGroup);
+  app.add_option("--atol-v", cvode.atolVelocity, "cvode: absolute tolerance of velocities (m/s)")
+      ->check(CLI::PositiveNumber)
+      ->group(implicitGroup);
+  app.add_flag("--contact-roots", cvode.contactRoots,
+               "cvode: locate contact onset and release as roots and restart there")
       ->group(implicitGroup);
   app.add_option("--max-order", cvode.maxOrder, "cvode: largest BDF order")
       ->check(CLI::Range(1, 5))
@@ -337,5 +366,13 @@ int main(int argc, char** argv) {
   opt.solver.implicit.clampCompression = opt.solver.cvode.clampCompression = !opt.noClamp;
   opt.solver.cvode.cgTolerance = opt.solver.implicit.cgTolerance;
   opt.solver.cvode.stabilityLimitDetection = !opt.noStabLimDet;
+  opt.solver.implicit.reuseFactor = !opt.noFactorReuse;
+  opt.solver.cvode.method =
+      opt.cvodeMethod == "adams" ? jello::CvodeMethod::Adams : jello::CvodeMethod::Bdf;
+  // --atol sets both; --atol-x and --atol-v win over it.
+  if (opt.atol > 0.0) {
+    if (opt.solver.cvode.atolPosition == 0.0) opt.solver.cvode.atolPosition = opt.atol;
+    if (opt.solver.cvode.atolVelocity == 0.0) opt.solver.cvode.atolVelocity = opt.atol;
+  }
   return run(opt);
 }
