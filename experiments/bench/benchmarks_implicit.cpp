@@ -4,7 +4,8 @@
 //   BM_Solve/N           CHOLMOD triangular solves
 //   BM_CgSolve/N         Jacobi-CG at tolerance 1e-6, warm-started from the last step
 //   BM_ImplicitStep/<solver>/N  one backward-Euler step at dt = 0.01 on jello.w at N^3
-//   BM_CvodeOneSecond/<rtol>    jello.w for 1 simulated second (counters: CVODE statistics)
+//   BM_CvodeOneSecond/<rtol>_<solver or adams>  jello.w for 1 simulated second (counters: CVODE
+//                               statistics)
 //   BM_StiffOneSecond/<method>/E  stiffCube(10^E) for 1 simulated second: implicit at
 //                               dt = 0.01 against RK4 at its largest stable dt (bisection)
 //   BM_ImplicitIntegratorStep/<integrator>/N/spinning  one step at dt = 0.01 (projective: 10
@@ -166,10 +167,12 @@ bool runOneSecond(Simulation& sim) {
   return true;
 }
 
-void BM_CvodeOneSecond(benchmark::State& st, double rtol, LinearSolverKind kind) {
+void BM_CvodeOneSecond(benchmark::State& st, double rtol, LinearSolverKind kind,
+                       CvodeMethod method = CvodeMethod::Bdf) {
   SolverOptions options;
   options.cvode.rtol = rtol;
   options.cvode.linearSolver = kind;
+  options.cvode.method = method;
   for (auto _ : st) {
     Simulation sim(jelloAt(8), IntegratorKind::Cvode, 0.01, options);
     if (!runOneSecond(sim)) st.SkipWithError("cvode failed");
@@ -180,6 +183,10 @@ BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e3_cholmod, 1e-3, LinearSolverKind::Ch
     ->Iterations(1)
     ->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e3_cg, 1e-3, LinearSolverKind::Cg)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e3_adams, 1e-3, LinearSolverKind::Cholmod,
+                  CvodeMethod::Adams)
     ->Iterations(1)
     ->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e6_cholmod, 1e-6, LinearSolverKind::Cholmod)
