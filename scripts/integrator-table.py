@@ -17,7 +17,7 @@ both:
       --benchmark_filter=ImplicitIntegratorStep --benchmark_min_time=0.2 \
       --benchmark_out=experiments/results/implicit_steps.json --benchmark_out_format=json
     OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 0 build/release/bin/benchmarks \
-      --benchmark_filter=Crossover \
+      --benchmark_filter='Crossover|CvodeOneSecond/rtol1e3' \
       --benchmark_out=experiments/results/crossover.json --benchmark_out_format=json
 """
 import argparse
@@ -41,6 +41,7 @@ STEPS_JSON = os.path.join(ROOT, "experiments", "results", "implicit_steps.json")
 STEPS_BEGIN, STEPS_END = "<!-- implicit-steps:begin -->", "<!-- implicit-steps:end -->"
 CROSSOVER_JSON = os.path.join(ROOT, "experiments", "results", "crossover.json")
 CROSSOVER_BEGIN, CROSSOVER_END = "<!-- crossover:begin -->", "<!-- crossover:end -->"
+CVODE_BEGIN, CVODE_END = "<!-- cvode-second:begin -->", "<!-- cvode-second:end -->"
 
 # integrator, dt (s), extra jello-sim arguments
 RUNS = [
@@ -153,7 +154,7 @@ def crossover_table_from_json():
         data = json.load(f)
     cells, order, exponents = {}, [], []
     for b in data["benchmarks"]:
-        if b.get("run_type") == "aggregate":
+        if b.get("run_type") == "aggregate" or not b["name"].startswith("BM_Crossover/"):
             continue
         _, method, exponent = b["name"].split("/")[:3]
         method = method.replace("_", "-")
@@ -174,6 +175,23 @@ def crossover_table_from_json():
         for e in exponents:
             row.append(f"{cells[('rk4', e)][0] / cells[(method, e)][0]:.2g}x")
         lines.append("| " + " | ".join(row) + " |")
+    return "\n".join(lines)
+
+
+def cvode_table_from_json():
+    """1 s of jello.w under CVODE at rtol 1e-3 (BM_CvodeOneSecond, same JSON as the crossover)."""
+    with open(CROSSOVER_JSON) as f:
+        data = json.load(f)
+    lines = ["| CVODE on 1 s of jello.w, rtol 1e-3 | wall time | steps | error-test failures "
+             "| factorizations |", "|---|---|---|---|---|"]
+    for b in data["benchmarks"]:
+        if not b["name"].startswith("BM_CvodeOneSecond/"):
+            continue
+        variant = b["name"].split("/")[1].split("_", 1)[1]
+        label = {"cholmod": "BDF, CHOLMOD", "cg": "BDF, CG", "adams": "Adams, fixed point"}
+        lines.append(f"| {label.get(variant, variant)} | {duration(milliseconds(b))} | "
+                     f"{b['cvode_steps']:.0f} | {b['error_test_failures']:.0f} | "
+                     f"{b.get('factorizations', 0):.0f} |")
     return "\n".join(lines)
 
 
@@ -225,6 +243,7 @@ def main():
         text = replace_between(text, BEGIN, END, table_from_csv())
         text = replace_between(text, STEPS_BEGIN, STEPS_END, steps_table_from_json())
         text = replace_between(text, CROSSOVER_BEGIN, CROSSOVER_END, crossover_table_from_json())
+        text = replace_between(text, CVODE_BEGIN, CVODE_END, cvode_table_from_json())
         write_atomically(README, text)
 
 
