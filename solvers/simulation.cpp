@@ -1,5 +1,6 @@
 #include "solvers/simulation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -7,18 +8,49 @@
 
 namespace jello {
 
-std::optional<std::string> findDivergence(const State& s, double bound) {
+namespace {
+
+// The largest |(a_p, b_p, c_p)| over points p of a component-major 3n vector.
+double largestNorm(const Eigen::VectorXd& v) {
+  const Eigen::Index n = v.size() / 3;
+  return (v.head(n).array().square() + v.segment(n, n).array().square() +
+          v.tail(n).array().square())
+      .maxCoeff();
+}
+
+}  // namespace
+
+std::optional<std::string> findDivergence(const State& s, double bound, double speedBound) {
   // A sum propagates any NaN or infinity; one pass each, both vectorize.
   if (!std::isfinite(s.x.sum() + s.v.sum())) {
     return std::string("a position or velocity is not finite");
   }
-  const double far = s.x.cwiseAbs().maxCoeff();
-  if (far > bound) {
+  if (s.x.size() == 0) return std::nullopt;
+  if (const double far = std::sqrt(largestNorm(s.x)); far > bound) {
     std::ostringstream os;
-    os << "a point is " << far << " m from the origin (bound " << bound << " m)";
+    os << "a point is " << far << " m from the origin (position bound " << bound << " m)";
+    return os.str();
+  }
+  if (const double fast = std::sqrt(largestNorm(s.v)); fast > speedBound) {
+    std::ostringstream os;
+    os << "a point moves at " << fast << " m/s (speed bound " << speedBound << " m/s)";
     return os.str();
   }
   return std::nullopt;
+}
+
+double Simulation::energyBudget() const {
+  return kEnergyGrowthFactor * energyStart_ + kEnergyFloor;
+}
+
+std::optional<std::string> Simulation::energyGrowth() {
+  const double now = model_.energy(state_).total() - externalWork_;
+  if (now <= energyBudget()) return std::nullopt;
+  std::ostringstream os;
+  os << "the energy grew to " << now << " J (energy bound " << kEnergyGrowthFactor
+     << " x its start " << energyStart_ << " J + " << kEnergyFloor
+     << " J, net of the field's and the user force's work)";
+  return os.str();
 }
 
 std::string Divergence::describe() const {
@@ -35,7 +67,8 @@ Simulation::Simulation(World world, std::optional<IntegratorKind> integrator,
       state_(initialState(world_)),
       options_(options),
       integrator_(makeIntegrator(integrator.value_or(world_.integrator), options_)),
-      dt_(dt.value_or(world_.dt)) {}
+      dt_(dt.value_or(world_.dt)),
+      energyStart_(std::max(0.0, model_.energy(state_).total())) {}
 
 StepResult Simulation::step() {
   if (divergence_) return StepResult::failure(divergence_->describe());
@@ -43,9 +76,19 @@ StepResult Simulation::step() {
                  "the state handed to a step is finite");
   previous_ = state_;
   StepResult result = integrator_->step(model_, state_, dt_);
-  std::optional<std::string> broken =
-      result.ok ? findDivergence(state_) : std::optional<std::string>(result.message);
+  // The speed at which one point alone would hold the whole energy budget.
+  const double speedBound =
+      std::sqrt(2.0 * (energyBudget() + std::max(0.0, externalWork_)) / model_.mass());
+  std::optional<std::string> broken = result.ok
+                                          ? findDivergence(state_, kDivergenceBound, speedBound)
+                                          : std::optional<std::string>(result.message);
   ++steps_;
+  if (!broken) {
+    // The work of the forces no potential describes, only for scenes that have them.
+    if (model_.hasField()) externalWork_ += model_.fieldWork(previous_.x.data(), state_.x.data());
+    if (model_.hasUserForce()) externalWork_ += model_.userForceWork(previous_.x, state_.x);
+    if (steps_ % kEnergyCheckInterval == 0) broken = energyGrowth();
+  }
   if (!broken) return result;
   state_ = previous_;
   divergence_ = Divergence{state_.t, steps_, integrator_->kind(), *broken};

@@ -3,6 +3,7 @@
 // drive a scene through this class.
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -14,12 +15,24 @@
 
 namespace jello {
 
-// A state has diverged when any value is not finite or a point is farther than this from the
-// origin (m): the box is [-2,2]^3, so no sane state comes near it.
+// A state has diverged when any value is not finite or a point is farther than
+// kDivergenceBound from the origin (m: the box is [-2,2]^3, so no sane state comes near it).
 inline constexpr double kDivergenceBound = 100.0;
+// A run has diverged, too, when its energy has grown: kinetic + spring + contact energy minus
+// the work the field and the user force have done exceeds the budget, kEnergyGrowthFactor times
+// its start plus kEnergyFloor (J, so that a cube starting at rest is not flagged by round-off),
+// the same factor as the stability experiment's blow-up rule. The whole energy is checked every
+// kEnergyCheckInterval steps (it costs about one force evaluation); at every step, a point
+// whose own kinetic energy exceeds the budget (a speed bound, sqrt(2 budget/m)) is caught.
+inline constexpr double kEnergyGrowthFactor = 10.0;
+inline constexpr double kEnergyFloor = 1.0;
+inline constexpr long kEnergyCheckInterval = 16;
 
-// Why `state` is broken, or nothing when it is sane.
-std::optional<std::string> findDivergence(const State& state, double bound = kDivergenceBound);
+// Why `state` is broken, or nothing when it is sane (not finite, too far, faster than
+// speedBound m/s; which bound fired is in the text).
+std::optional<std::string> findDivergence(
+    const State& state, double bound = kDivergenceBound,
+    double speedBound = std::numeric_limits<double>::infinity());
 
 struct Divergence {
   double time = 0.0;  // s, simulated time of the last sane state
@@ -70,6 +83,11 @@ class Simulation {
   double dt_;
   long steps_ = 0;
   std::optional<Divergence> divergence_;
+  // The energy rule: the budget's start, and the work done by the field and the user force.
+  double energyStart_ = 0.0;
+  double externalWork_ = 0.0;
+  std::optional<std::string> energyGrowth();
+  double energyBudget() const;
 };
 
 }  // namespace jello

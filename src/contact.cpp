@@ -60,9 +60,13 @@ void WallContact::addJacobian(const double* x, int n, JacobianBlocks& out) const
 }
 
 PlaneContact::PlaneContact(const Plane& plane, ContactConstants k) : k_(k) {
-  const double len = norm(Vec3{plane.a, plane.b, plane.c});
-  normal_ = Vec3{plane.a, plane.b, plane.c} * (1.0 / len);
-  offset_ = plane.d / len;
+  // Scaled by the largest coefficient first: normals from 1e-300 to 1e300 give the same plane.
+  const Vec3 n{plane.a, plane.b, plane.c};
+  const double scale = maxAbs(n);
+  const Vec3 scaled{n.x / scale, n.y / scale, n.z / scale};  // 1/scale overflows if subnormal
+  const double len = norm(scaled);
+  normal_ = scaled * (1.0 / len);
+  offset_ = (plane.d / scale) / len;
 }
 
 void PlaneContact::accumulate(const double* __restrict x, const double* __restrict v,

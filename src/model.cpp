@@ -129,6 +129,10 @@ bool Model::contactBegins(const double* x0, const double* x1) const {
   return false;
 }
 
+double Model::userForceWork(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1) const {
+  return userForce_ ? userForce_->dot(x1 - x0) : 0.0;
+}
+
 double Model::fieldWork(const double* x0, const double* x1) const {
   if (!field_) return 0.0;
   const int n = n_;

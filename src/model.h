@@ -82,6 +82,8 @@ class Model {
   // trapezoid rule along the straight path: sum of 1/2 (F(x0) + F(x1)) . (x1 - x0). Exact for
   // a uniform field; 0 without a field.
   double fieldWork(const double* x0, const double* x1) const;
+  // Work (J) of the user force (constant) over the move from x0 to x1; 0 without one.
+  double userForceWork(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1) const;
 
   Energy energy(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const;
   // Angular momentum about the centre of mass (kg m^2/s).

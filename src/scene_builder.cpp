@@ -11,7 +11,7 @@ namespace jello {
 namespace {
 
 Vec3 rotate(const Vec3& v, Vec3 axis, double radians) {
-  axis = axis * (1.0 / norm(axis));
+  axis = unitVector(axis);  // robust to axes like (1e200, 1e200, 0) or (1e-200, 0, 0)
   const double c = std::cos(radians), s = std::sin(radians);
   // Rodrigues' rotation formula.
   return v * c + cross(axis, v) * s + axis * (dot(axis, v) * (1.0 - c));

@@ -32,5 +32,18 @@ constexpr Vec3 cross(const Vec3& a, const Vec3& b) {
 inline double norm(const Vec3& a) {
   return std::sqrt(dot(a, a));
 }
+// The largest component's magnitude: what to scale by before squaring.
+inline double maxAbs(const Vec3& a) {
+  return std::fmax(std::fabs(a.x), std::fmax(std::fabs(a.y), std::fabs(a.z)));
+}
+// a / |a|, scaled by its largest component first, so that neither |a|^2 overflows (components
+// up to the largest double) nor underflows (down to the smallest subnormal). The zero vector
+// and non-finite vectors give NaN components: callers refuse those first.
+inline Vec3 unitVector(const Vec3& a) {
+  const double s = maxAbs(a);
+  const Vec3 b{a.x / s, a.y / s, a.z / s};  // divided: 1/s overflows for subnormal s
+  const double l = norm(b);
+  return {b.x / l, b.y / l, b.z / l};
+}
 
 }  // namespace jello

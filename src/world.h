@@ -3,6 +3,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "src/integrator_name.h"
@@ -35,6 +36,9 @@ inline constexpr int kDefaultCubeResolution = 8;  // the only one the original f
 
 struct World {
   IntegratorKind integrator = IntegratorKind::RK4;
+  // The file's integrator name when it was not one of ours and the reader was told to accept
+  // it (ReaderLimits::acceptUnknownIntegrator); empty otherwise. Never written back.
+  std::string unknownIntegrator;
   double dt = 0.0005;       // s, time step
   int stepsPerFrame = 1;    // n: integrator steps per drawn frame
   double kElastic = 0.0;    // N/m, structural, shear and bend springs

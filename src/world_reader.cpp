@@ -171,8 +171,14 @@ World parseWorld(std::string_view text, const std::string& name, const ReaderLim
   const Token integrator = in.next();
   if (integrator.text.empty()) in.fail(integrator, "empty file: no integrator name");
   const auto kind = parseIntegratorName(integrator.text);
-  if (!kind) in.fail(integrator, "unknown integrator (known: " + integratorNameList() + ")");
-  w.integrator = *kind;
+  if (kind) {
+    w.integrator = *kind;
+  } else if (limits.acceptUnknownIntegrator) {
+    w.unknownIntegrator = std::string(integrator.text);  // the caller overrides it
+  } else {
+    in.fail(integrator, "unknown integrator (known: " + integratorNameList() +
+                            "; --integrator on the command line overrides it)");
+  }
 
   w.dt = in.positive("the time step dt");
   w.stepsPerFrame = in.integer("n (steps per frame)");

@@ -18,6 +18,10 @@ struct ReaderLimits {
   int maxFieldResolution = 128;            // nodes per axis: 128^3 nodes = 50 MB
   int maxCubeResolution = 64;              // points per axis: 64^3 points
   std::uintmax_t maxFileBytes = 1u << 28;  // 256 MiB
+  // An integrator name not in our table is accepted (the world keeps RK4 and records the name
+  // in World::unknownIntegrator) when the caller overrides the integrator anyway: files by
+  // other authors of the course name integrators they added (`Midpoint`, `IPC`).
+  bool acceptUnknownIntegrator = false;
 };
 
 class WorldFileError : public std::runtime_error {

@@ -5,8 +5,11 @@
 #include <sys/wait.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
 
 #include "src/atomic_file.h"
 #include "src/scene_builder.h"
@@ -294,6 +297,83 @@ TEST(JelloSim, WritesStatsToDevStdoutAndLeavesADeviceADevice) {
   const Outcome out = run(sim() + " " + world("jello.w") + " --steps 5 -q --out " + node.string());
   EXPECT_EQ(out.code, 0) << out.output;
   EXPECT_TRUE(std::filesystem::is_character_file(node));
+}
+
+TEST(JelloSim, IntegratorOnTheCommandLineRescuesAFileNamingAnUnknownOne) {
+  // Files by other course authors name integrators they added ("Midpoint", "IPC").
+  test::TempDir dir;
+  const auto file = dir.path() / "ipc.w";
+  std::string text = test::readFile(world("jello.w"));
+  text.replace(0, text.find('\n'), "IPC");
+  { std::ofstream(file) << text; }
+  const Outcome refused = run(sim() + " " + file.string() + " --steps 5 -q 2>&1");
+  EXPECT_EQ(refused.code, 1) << refused.output;
+  EXPECT_TRUE(contains(refused.output, ":1:")) << refused.output;  // file:line
+  EXPECT_TRUE(contains(refused.output, "--integrator")) << refused.output;
+  const Outcome rescued = run(sim() + " " + file.string() + " --steps 5 -q --integrator rk4 2>&1");
+  EXPECT_EQ(rescued.code, 0) << rescued.output;
+  EXPECT_TRUE(contains(rescued.output, "warning")) << rescued.output;
+  EXPECT_TRUE(contains(rescued.output, "'IPC'")) << rescued.output;
+}
+
+TEST(JelloSim, AClosedOutputPipeDoesNotKillTheRun) {
+  // `jello-sim ... | :` : the reader is gone before the summary is printed. SIGPIPE is ignored,
+  // the write fails with EPIPE, and the run still writes its statistics and exits 0.
+  test::TempDir dir;
+  const auto stats = dir.path() / "s.json", rc = dir.path() / "rc";
+  const Outcome r = run("bash -c '(" + sim() + " " + world("jello.w") + " --steps 4000 --stats " +
+                        stats.string() + " 2>&1; echo $? > " + rc.string() + ") | :'");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(test::readFile(rc), "0\n");
+  EXPECT_TRUE(std::filesystem::exists(stats));
+}
+
+// Every numeric option of every program refuses NaN and infinities with exit code 2, found
+// from each program's own --help, so a new option is covered without being listed here.
+TEST(EveryProgram, RefusesNanAndInfinityInEveryNumericOption) {
+  const std::filesystem::path bin = std::filesystem::path(sim()).parent_path();
+  const std::string jelloWorld = world("jello.w");
+  struct Program {
+    std::string name, arguments;  // arguments every run needs (a world file)
+  };
+  const Program programs[] = {{"jello-sim", jelloWorld}, {"jello-create-world", ""},
+                              {"jello-stability", ""},   {"jello-work-precision", ""},
+                              {"jello-scaling", ""},     {"jello", jelloWorld}};
+  // "  --plane FLOAT x 4 ...", "  -n,--steps-per-frame INT:INT in [1 - 1000000]=1"
+  const std::regex numeric(R"(^\s+(?:-\w,)?(--[\w-]+) ((?:FLOAT|INT|UINT)\S*)(?: x (\d+))?)");
+  int checked = 0;
+  for (const Program& program : programs) {
+    const std::filesystem::path path = bin / program.name;
+    if (!std::filesystem::exists(path)) {
+      std::printf("%s is not built here: not checked\n", program.name.c_str());
+      continue;
+    }
+    const Outcome help = run(path.string() + " --help");
+    ASSERT_EQ(help.code, 0) << program.name;
+    std::istringstream lines(help.output);
+    std::string line;
+    while (std::getline(lines, line)) {
+      std::smatch m;
+      if (!std::regex_search(line, m, numeric)) continue;
+      const std::string option = m[1];
+      const bool floating = m[2].str().rfind("FLOAT", 0) == 0;
+      const int count = m[3].matched ? std::stoi(m[3]) : 1;
+      for (const char* bad : {"nan", "inf", "-inf"}) {
+        std::string values;
+        for (int i = 0; i < count; ++i) values += std::string(" ") + bad;
+        const Outcome r =
+            run(path.string() + " " + program.arguments + " " + option + values + " 2>&1");
+        EXPECT_EQ(r.code, 2) << program.name << " " << option << values << "\n" << r.output;
+        // ("-inf" may be taken for an option by CLI11 and refused as such: exit 2 all the same.)
+        if (floating && std::string(bad) != "-inf") {
+          EXPECT_TRUE(contains(r.output, "finite")) << program.name << " " << option << "\n"
+                                                    << r.output;
+        }
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 40);  // the programs have at least this many numeric options
 }
 
 }  // namespace

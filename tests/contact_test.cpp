@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
+#include <cmath>
+
+#include "src/scene_builder.h"
 
 namespace jello {
 namespace {
@@ -91,6 +94,37 @@ TEST(PlaneContact, PushesTowardTheFreeSideAlongTheNormal) {
   EXPECT_NEAR(norm(f - n * dot(f, n)), 0.0, 1e-12);
   EXPECT_EQ(forceOn(plane, onPlane + n * 0.02), (Vec3{0, 0, 0}));
   expectForceIsMinusEnergyGradient(plane, solid);
+}
+
+TEST(PlaneContact, ExtremeNormalsGiveTheSamePlane) {
+  // Scaling a, b, c, d by any positive factor is the same plane: from 1e-300 (whose squares
+  // underflow) to 1e300 (whose squares overflow).
+  const PlaneContact reference(Plane{-1, 1, 1, 2}, kContact);
+  for (double s : {1e-300, 1e-170, 1e-160, 1e150, 1e160, 1e300}) {
+    const PlaneContact plane(Plane{-s, s, s, 2 * s}, kContact);
+    EXPECT_NEAR(norm(plane.normal() - reference.normal()), 0.0, 1e-15) << s;
+    EXPECT_NEAR(plane.offset(), reference.offset(), 1e-15) << s;
+  }
+}
+
+TEST(Vec3, UnitVectorOfHugeAndTinyVectors) {
+  EXPECT_NEAR(norm(unitVector({1e200, 1e200, 0}) - Vec3{M_SQRT1_2, M_SQRT1_2, 0}), 0.0, 1e-15);
+  EXPECT_NEAR(norm(unitVector({1e-310, 0, 0}) - Vec3{1, 0, 0}), 0.0, 1e-15);  // subnormal
+  EXPECT_TRUE(std::isnan(unitVector({0, 0, 0}).x));
+}
+
+TEST(SceneBuilder, AHugeRotationAxisRotatesLikeAUnitOne) {
+  // jello-create-world --axis 1e200 1e200 0 used to shrink the cube (|axis|^2 overflowed).
+  SceneSpec unit, huge;
+  unit.pose = huge.pose = PosePreset::Rotated;
+  unit.rotateAxis = {1, 1, 0};
+  huge.rotateAxis = {1e200, 1e200, 0};
+  const World a = buildWorld(unit), b = buildWorld(huge);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.positions.size(); ++i) {
+    worst = std::max(worst, norm(a.positions[i] - b.positions[i]));
+  }
+  EXPECT_LT(worst, 1e-12);
 }
 
 TEST(SphereContact, PushesRadiallyOut) {

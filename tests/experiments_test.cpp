@@ -55,11 +55,13 @@ TEST(StabilityAnalysis, BlewUpMeansDivergedOrTenfoldEnergyWithinTheRunTime) {
   const Trial above = runTrial(w, IntegratorKind::RK4, 1.2 * limit, rule);
   EXPECT_TRUE(above.blewUp);
   EXPECT_LT(above.steps, std::lround(0.1 / (1.2 * limit)));
-  // A huge factor leaves only the divergence check: still caught, later.
+  // A huge factor leaves only the simulation's own divergence check, which applies the same
+  // tenfold energy rule (solvers/simulation.h, every 16 steps) besides its bounds: still
+  // caught, as a divergence, no earlier.
   const Trial diverged = runTrial(w, IntegratorKind::RK4, 1.2 * limit, {0.1, 1e300});
   EXPECT_TRUE(diverged.blewUp);
   EXPECT_NE(diverged.reason.find("diverged"), std::string::npos) << diverged.reason;
-  EXPECT_GT(diverged.steps, above.steps);
+  EXPECT_GE(diverged.steps, above.steps);
 }
 
 // Share of the bottom layer's samples (every step, every bottom point) above the floor.

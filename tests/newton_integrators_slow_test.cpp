@@ -62,15 +62,20 @@ double angularMomentumKept(IntegratorKind kind, double k, double newtonTolerance
   // 3 of 20 steps unconverged at 200 iterations and ending elsewhere. The other methods are
   // measured as users run them.
   options.implicit.reuseFactor = kind != IntegratorKind::Newmark;
-  Simulation sim(buildWorld(spec), kind, 0.01, options);
-  const Eigen::Vector3d L0 = angularMomentum(sim.model(), sim.state());
-  for (int i = 0; i < 20; ++i) EXPECT_TRUE(sim.step().ok) << integratorName(kind);
-  for (const Statistic& stat : sim.integrator().statistics()) {
+  // The integrator alone, not a Simulation: newmark's energy gain here is what Simulation
+  // reports as a divergence, and this test measures the method.
+  const World w = buildWorld(spec);
+  const Model model(w);
+  State s = initialState(w);
+  const std::unique_ptr<Integrator> method = makeIntegrator(kind, options);
+  const Eigen::Vector3d L0 = angularMomentum(model, s);
+  for (int i = 0; i < 20; ++i) EXPECT_TRUE(method->step(model, s, 0.01).ok) << integratorName(kind);
+  for (const Statistic& stat : method->statistics()) {
     if (stat.name == "newton_unconverged_steps") {
       EXPECT_EQ(stat.value, 0.0) << integratorName(kind);
     }
   }
-  return angularMomentum(sim.model(), sim.state()).dot(L0) / L0.squaredNorm();
+  return angularMomentum(model, s).dot(L0) / L0.squaredNorm();
 }
 
 TEST(NewtonIntegrators, KeepTheAngularMomentumOfASpinningStretchedCube) {

@@ -62,6 +62,47 @@ TEST(Simulation, FindsNonFiniteValuesAndFarPoints) {
   EXPECT_TRUE(findDivergence(far).has_value());
 }
 
+TEST(Simulation, FindsFastPointsAndFarPointsByTheirDistance) {
+  State s = initialState(test::loadWorld("jello.w"));
+  State fast = s;
+  fast.v[3] = 2000.0;                              // 2 km/s
+  EXPECT_FALSE(findDivergence(fast).has_value());  // no speed bound given
+  const auto reason = findDivergence(fast, kDivergenceBound, 1000.0);
+  ASSERT_TRUE(reason.has_value());
+  EXPECT_NE(reason->find("speed bound"), std::string::npos) << *reason;
+  // (80, 80, 0) is 113 m out although no coordinate passes 100 m.
+  State diagonal = s;
+  const int n = s.numPoints();
+  diagonal.x[0] = 80.0;
+  diagonal.x[n] = 80.0;
+  const auto far = findDivergence(diagonal);
+  ASSERT_TRUE(far.has_value());
+  EXPECT_NE(far->find("position bound"), std::string::npos) << *far;
+}
+
+TEST(Simulation, OneEulerStepAtHugeStiffnessIsADivergenceByItsSpeed) {
+  // Euler at k = 10^7 for one step used to exit 0 with velocities of 5e6 m/s.
+  Simulation sim(stiff(1e7), IntegratorKind::Euler, 0.01);
+  EXPECT_FALSE(sim.step().ok);
+  ASSERT_TRUE(sim.divergence().has_value());
+  EXPECT_NE(sim.divergence()->reason.find("bound"), std::string::npos);
+}
+
+TEST(Simulation, EnergyGrowthIsADivergence) {
+  // RK4 on the stiff k = 10^4 cube just above its stability limit grows slowly: no point is far
+  // or fast for a while, but the energy passes 10 times its start.
+  // It used to run 50 steps and exit 0 with its energy up 70x.
+  World w = test::loadWorld("stiff-k1e4.w");
+  Simulation sim(w, IntegratorKind::RK4, 3.3e-4);
+  for (int i = 0; i < 50 && sim.step().ok; ++i) {
+  }
+  ASSERT_TRUE(sim.divergence().has_value());
+  EXPECT_NE(sim.divergence()->reason.find("energy"), std::string::npos) << sim.divergence()->reason;
+  // And a stable run with the field's work counted is not flagged: gravity.w falls for 1 s.
+  Simulation falling(test::loadWorld("gravity.w"));
+  for (int i = 0; i < 2000; ++i) ASSERT_TRUE(falling.step().ok) << i;
+}
+
 TEST(Simulation, SwitchingIntegratorKeepsTheState) {
   Simulation sim(test::loadWorld("jello.w"));
   for (int i = 0; i < 10; ++i) ASSERT_TRUE(sim.step().ok);

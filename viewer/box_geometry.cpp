@@ -28,8 +28,12 @@ std::array<std::pair<Vec3, Vec3>, 12> boxEdges() {
 }
 
 std::vector<Vec3> planeInBox(const Plane& plane) {
-  const Vec3 normal{plane.a, plane.b, plane.c};
-  const auto side = [&](const Vec3& p) { return dot(normal, p) + plane.d; };
+  // Scaled by the largest coefficient, so that huge or tiny coefficients neither overflow nor
+  // underflow in the products.
+  const double scale = maxAbs(Vec3{plane.a, plane.b, plane.c});
+  const Vec3 normal{plane.a / scale, plane.b / scale, plane.c / scale};
+  const double offset = plane.d / scale;
+  const auto side = [&](const Vec3& p) { return dot(normal, p) + offset; };
   std::vector<Vec3> corners;
   for (const auto& [a, b] : boxEdges()) {
     const double sa = side(a), sb = side(b);

@@ -9,6 +9,7 @@
 #include <regex>
 
 #include "solvers/solver_threads.h"
+#include "src/finite_options.h"
 #include "src/world_reader.h"
 #include "viewer/viewer_app.h"
 #include "viewer/viewer_state.h"
@@ -38,11 +39,11 @@ int main(int argc, char** argv) {
   app.add_option("--integrator", integrator,
                  "Integrator, overriding the file's: " + jello::integratorNameList());
   app.add_option("--dt", opt.source.dt, "Time step (s), overriding the file's")
-      ->check(CLI::PositiveNumber);
+      ->check(jello::cli::positive());
   auto* record = app.add_option("--record", opt.recordDir,
                                 "Write frames 000.jpg, 001.jpg, ... into this directory and exit");
   app.add_option("--frames", opt.frames, "Number of frames to record (1-300: 15 per second)")
-      ->check(CLI::Range(1, jello::viewer::kMaxRecordedFrames))
+      ->check(jello::cli::range(1, jello::viewer::kMaxRecordedFrames))
       ->needs(record);
   record->needs("--frames");
   app.add_option("--size", size, "Window size WxH in pixels")->capture_default_str();
@@ -52,18 +53,19 @@ int main(int argc, char** argv) {
   app.add_flag("!--no-hud", opt.hud, "Hide the heads-up line");
   app.add_option("--benchmark", opt.benchmarkFrames,
                  "Draw this many frames as fast as possible, print frames/s and exit")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->excludes(record);
   app.add_option("--max-field-resolution", opt.source.limits.maxFieldResolution,
                  "Largest force-field resolution a world may ask for")
-      ->check(CLI::Range(2, 1024))
+      ->check(jello::cli::range(2, 1024))
       ->capture_default_str();
   app.add_option("--max-cube-resolution", opt.source.limits.maxCubeResolution,
                  "Largest cube resolution a world may ask for")
-      ->check(CLI::Range(2, 256))
+      ->check(jello::cli::range(2, 256))
       ->capture_default_str();
   try {
     app.parse(argc, argv);
+    jello::refuseNonFiniteNumbers(app);
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : kExitUsage;
@@ -90,11 +92,19 @@ int main(int argc, char** argv) {
     }
   }
   opt.source.world = world;
+  // With --integrator, a file naming an integrator we do not have still loads (with a warning).
+  opt.source.limits.acceptUnknownIntegrator = opt.source.integrator.has_value();
   jello::World loaded;
   try {
     loaded = jello::readWorld(opt.source.world, opt.source.limits);
   } catch (const std::exception& e) {
     return usageError(e.what());
+  }
+  if (!loaded.unknownIntegrator.empty()) {
+    std::fprintf(stderr,
+                 "jello: warning: %s names the integrator '%s', unknown here; stepping "
+                 "with --integrator %s\n",
+                 world.c_str(), loaded.unknownIntegrator.c_str(), integrator.c_str());
   }
   return jello::viewer::runViewer(opt, std::move(loaded));
 }

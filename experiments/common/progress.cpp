@@ -22,9 +22,14 @@ void Progress::draw(long done, long total) {
   last_ = now;
   const double fraction = total > 0 ? double(done) / double(total) : 0.0;
   const double eta = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
-  std::fprintf(stderr, "%s[%3.0f%%] %ld/%ld %s, %.0f s elapsed, %.0f s left%s", tty_ ? "\r" : "",
-               100.0 * fraction, done, total, label_.c_str(), elapsed, eta, tty_ ? "\033[K" : "\n");
-  std::fflush(stderr);
+  const int written = std::fprintf(stderr, "%s[%3.0f%%] %ld/%ld %s, %.0f s elapsed, %.0f s left%s",
+                                   tty_ ? "\r" : "", 100.0 * fraction, done, total, label_.c_str(),
+                                   elapsed, eta, tty_ ? "\033[K" : "\n");
+  if (written < 0 || std::fflush(stderr) != 0) {
+    enabled_ = false;  // standard error is closed (EPIPE): the run goes on without a progress line
+    std::clearerr(stderr);
+    return;
+  }
   drawn_ = true;
 }
 

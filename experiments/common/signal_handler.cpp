@@ -11,4 +11,8 @@ void setSignalHandler(const char* program, int signo, void (*handler)(int)) {
   }
 }
 
+void ignoreBrokenPipes(const char* program) {
+  setSignalHandler(program, SIGPIPE, SIG_IGN);
+}
+
 }  // namespace jello

@@ -11,12 +11,14 @@
 #include <iostream>
 #include <thread>
 
+#include "experiments/common/signal_handler.h"
 #include "experiments/studies/csv_table.h"
 #include "experiments/studies/parallel_for.h"
 #include "experiments/studies/run_context.h"
 #include "experiments/studies/stability_analysis.h"
 #include "solvers/simulation.h"
 #include "solvers/solver_threads.h"
+#include "src/finite_options.h"
 #include "src/scene_builder.h"
 
 namespace {
@@ -41,6 +43,7 @@ double statistic(const Integrator& integrator, const std::string& name) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  jello::ignoreBrokenPipes("jello-scaling");
   applySolverThreadSettings(argv);
   std::vector<int> ns{8, 12, 16, 24, 32};
   double k = 1e4, budget = 3.0, implicitDt = 0.01, rtol = 1e-3;
@@ -49,22 +52,22 @@ int main(int argc, char** argv) {
   bool quick = false, quiet = false;
   std::string outDir = "experiments/results", name = "scaling";
   CLI::App app{"jello-scaling: wall time per simulated second against cube resolution"};
-  app.add_option("--n", ns, "Cube resolutions")->check(CLI::Range(2, 64))->delimiter(',');
+  app.add_option("--n", ns, "Cube resolutions")->check(jello::cli::range(2, 64))->delimiter(',');
   app.add_option("--k", k, "Spring stiffness, N/m")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->capture_default_str();
   app.add_option("--budget", budget, "Wall seconds to run each point for (at least one step)")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->capture_default_str();
   app.add_option("--implicit-dt", implicitDt, "Time step of implicit, output interval of cvode, s")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->capture_default_str();
   app.add_option("--rtol", rtol, "cvode's relative tolerance")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->capture_default_str();
   app.add_option("--jobs", jobs,
                  "Points run in parallel (1 gives timings free of a neighbour's memory traffic)")
-      ->check(CLI::Range(1, 256))
+      ->check(jello::cli::range(1, 256))
       ->capture_default_str();
   app.add_option("--out-dir", outDir, "Directory for NAME.csv and NAME.json")
       ->capture_default_str();
@@ -77,6 +80,7 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet", quiet, "No progress line");
   try {
     app.parse(argc, argv);
+    jello::refuseNonFiniteNumbers(app);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }

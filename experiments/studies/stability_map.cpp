@@ -9,12 +9,14 @@
 #include <iostream>
 #include <thread>
 
+#include "experiments/common/signal_handler.h"
 #include "experiments/studies/csv_table.h"
 #include "experiments/studies/parallel_for.h"
 #include "experiments/studies/run_context.h"
 #include "experiments/studies/stability_analysis.h"
 #include "solvers/simulation.h"
 #include "solvers/solver_threads.h"
+#include "src/finite_options.h"
 
 namespace {
 
@@ -47,42 +49,43 @@ struct Point {
 }  // namespace
 
 int main(int argc, char** argv) {
+  jello::ignoreBrokenPipes("jello-stability");
   applySolverThreadSettings(argv);
   Options opt;
   CLI::App app{
       "jello-stability: largest stable time step per integrator and stiffness, "
       "measured against predicted"};
   app.add_option("--k", opt.ks, "Spring stiffnesses, N/m (default 10 to 1e6, 2 per decade)")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->delimiter(',');
   app.add_option("--scenes", opt.scenes, "Scenes: free (no contact), wall (resting on the floor)")
       ->check(CLI::IsMember({"free", "wall"}))
       ->delimiter(',');
   app.add_option("--integrators", opt.integrators, "Integrators (default all)")->delimiter(',');
   app.add_option("--damping-ratio", opt.dampingRatio, "Spring damping c/k, s")
-      ->check(CLI::NonNegativeNumber)
+      ->check(jello::cli::nonNegative())
       ->capture_default_str();
   app.add_option("--contact-ratio", opt.contactRatio, "Wall scene: contact stiffness over k")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->capture_default_str();
   app.add_option("--time", opt.rule.time, "Simulated time a stable run must survive, s")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->capture_default_str();
   app.add_option("--energy-factor", opt.rule.energyFactor,
                  "Blow-up when the total energy exceeds this times its start")
-      ->check(CLI::Range(1.0, 1e12))
+      ->check(jello::cli::range(1.0, 1e12))
       ->capture_default_str();
   app.add_option("--tolerance", opt.tolerance, "Bisection stops at unstable/stable <= 1 + this")
-      ->check(CLI::Range(1e-4, 1.0))
+      ->check(jello::cli::range(1e-4, 1.0))
       ->capture_default_str();
   app.add_option("--dt-max", opt.dtMax, "Largest time step tried, s")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->capture_default_str();
   app.add_option("--rtol", opt.rtol, "cvode's relative tolerance")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->capture_default_str();
   app.add_option("--jobs", opt.jobs, "Grid points run in parallel")
-      ->check(CLI::Range(1, 256))
+      ->check(jello::cli::range(1, 256))
       ->capture_default_str();
   app.add_option("--out-dir", opt.outDir, "Directory for NAME.csv and NAME.json")
       ->capture_default_str();
@@ -92,6 +95,7 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet", opt.quiet, "No progress line");
   try {
     app.parse(argc, argv);
+    jello::refuseNonFiniteNumbers(app);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }

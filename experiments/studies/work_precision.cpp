@@ -11,12 +11,14 @@
 #include <iostream>
 #include <thread>
 
+#include "experiments/common/signal_handler.h"
 #include "experiments/studies/csv_table.h"
 #include "experiments/studies/parallel_for.h"
 #include "experiments/studies/run_context.h"
 #include "experiments/studies/stability_analysis.h"
 #include "solvers/simulation.h"
 #include "solvers/solver_threads.h"
+#include "src/finite_options.h"
 #include "src/scene_builder.h"
 #include "src/world_reader.h"
 
@@ -84,6 +86,7 @@ struct Task {
 }  // namespace
 
 int main(int argc, char** argv) {
+  jello::ignoreBrokenPipes("jello-work-precision");
   applySolverThreadSettings(argv);
   int levels = 7, jobs = int(std::max(1u, std::thread::hardware_concurrency()));
   double stiffK = 1e4;
@@ -93,14 +96,14 @@ int main(int argc, char** argv) {
       "jello-work-precision: error against wall time per integrator, and backward "
       "Euler's artificial damping"};
   app.add_option("--levels", levels, "Time steps per integrator (halving from its largest)")
-      ->check(CLI::Range(2, 12))
+      ->check(jello::cli::range(2, 12))
       ->capture_default_str();
   app.add_option("--stiff-k", stiffK, "Stiffness of the stiff scene, N/m")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->capture_default_str();
   app.add_option("--worlds", worldsDir, "Directory holding jello.w")->capture_default_str();
   app.add_option("--jobs", jobs, "Runs in parallel")
-      ->check(CLI::Range(1, 256))
+      ->check(jello::cli::range(1, 256))
       ->capture_default_str();
   app.add_option("--out-dir", outDir, "Directory for NAME.csv and NAME.json")
       ->capture_default_str();
@@ -111,6 +114,7 @@ int main(int argc, char** argv) {
   app.add_flag("--quiet", quiet, "No progress line");
   try {
     app.parse(argc, argv);
+    jello::refuseNonFiniteNumbers(app);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }

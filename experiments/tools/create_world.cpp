@@ -11,6 +11,7 @@
 
 #include "experiments/common/signal_handler.h"
 #include "src/atomic_file.h"
+#include "src/finite_options.h"
 #include "src/scene_builder.h"
 #include "src/world_reader.h"
 #include "src/world_writer.h"
@@ -28,6 +29,7 @@ Vec3 toVec3(const std::vector<double>& v) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  jello::ignoreBrokenPipes("jello-create-world");
   // A file-size limit fails the write (reported), not the process.
   jello::setSignalHandler("jello-create-world", SIGXFSZ, SIG_IGN);
   jello::SceneSpec spec;
@@ -46,25 +48,25 @@ int main(int argc, char** argv) {
   app.add_option("--integrator", integrator, "Integrator: " + jello::integratorNameList())
       ->capture_default_str();
   app.add_option("--dt", spec.dt, "Time step, s")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->capture_default_str();
   app.add_option("-n,--steps-per-frame", spec.stepsPerFrame, "Steps per drawn frame")
-      ->check(CLI::Range(1, 1000000))
+      ->check(jello::cli::range(1, 1000000))
       ->capture_default_str();
   app.add_option("--k-elastic", spec.kElastic, "Spring stiffness, N/m")
-      ->check(CLI::NonNegativeNumber)
+      ->check(jello::cli::nonNegative())
       ->capture_default_str();
   app.add_option("--d-elastic", spec.dElastic, "Spring damping, N*s/m")
-      ->check(CLI::NonNegativeNumber)
+      ->check(jello::cli::nonNegative())
       ->capture_default_str();
   app.add_option("--k-collision", spec.kCollision, "Contact stiffness, N/m")
-      ->check(CLI::NonNegativeNumber)
+      ->check(jello::cli::nonNegative())
       ->capture_default_str();
   app.add_option("--d-collision", spec.dCollision, "Contact damping, N*s/m")
-      ->check(CLI::NonNegativeNumber)
+      ->check(jello::cli::nonNegative())
       ->capture_default_str();
   app.add_option("--mass", spec.mass, "Mass of each point, kg (default 1/512)")
-      ->check(CLI::PositiveNumber);
+      ->check(jello::cli::positive());
   auto* planeOpt = app.add_option("--plane", plane,
                                   "Inclined plane A B C D: Ax+By+Cz+D=0, "
                                   "free where positive (default -1 1 1 2)")
@@ -86,7 +88,7 @@ int main(int argc, char** argv) {
                  "radial 25*mass N/m");
   app.add_option("--field-resolution", spec.fieldResolution,
                  "Field nodes per axis, 2..128, or 0 for no field (default 30)")
-      ->check(CLI::Range(0, 128));
+      ->check(jello::cli::range(0, 128));
 
   const std::map<std::string, PosePreset> poses{{"rest", PosePreset::Rest},
                                                 {"skewed", PosePreset::SkewedCorner},
@@ -99,7 +101,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember(poses, CLI::ignore_case))
       ->capture_default_str();
   app.add_option("--stretch", spec.stretch, "Stretch factor along x for --pose stretched")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->capture_default_str();
   app.add_option("--rotate", spec.rotateDegrees, "Angle, degrees, for --pose rotated")
       ->capture_default_str();
@@ -118,12 +120,13 @@ int main(int argc, char** argv) {
   app.add_option("--sphere", sphere, "Sphere obstacle CX CY CZ R (an extension)")->expected(4);
   app.add_option("--cube", spec.cubeResolution,
                  "Cube resolution N: N^3 points (default 8; other values are an extension)")
-      ->check(CLI::Range(2, 64));
+      ->check(jello::cli::range(2, 64));
   app.add_flag("--legacy", legacy,
                "Print six decimals like the original creator (not exact: 1/512 becomes "
                "0.001953)");
   try {
     app.parse(argc, argv);
+    jello::refuseNonFiniteNumbers(app);
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
@@ -146,7 +149,7 @@ int main(int argc, char** argv) {
   if (!translate.empty()) spec.translate = toVec3(translate);
   if (!axis.empty()) spec.rotateAxis = toVec3(axis);
   spec.fieldStrength = fieldStrength.value_or(jello::defaultFieldStrength(spec.field, spec.mass));
-  if (spec.pose == PosePreset::Rotated && jello::norm(spec.rotateAxis) == 0.0) {
+  if (spec.pose == PosePreset::Rotated && jello::maxAbs(spec.rotateAxis) == 0.0) {
     std::fprintf(stderr, "jello-create-world: error: --axis must not be zero\n");
     return 2;
   }

@@ -18,6 +18,7 @@
 #include "solvers/simulation.h"
 #include "solvers/solver_threads.h"
 #include "src/atomic_file.h"
+#include "src/finite_options.h"
 #include "src/scene_builder.h"
 #include "src/world_reader.h"
 #include "src/world_writer.h"
@@ -88,10 +89,18 @@ class Trace {
 int run(const Options& opt) {
   jello::World world;
   try {
-    world = jello::readWorld(opt.world, opt.limits);
+    jello::ReaderLimits limits = opt.limits;
+    limits.acceptUnknownIntegrator = !opt.integrator.empty();  // --integrator overrides it
+    world = jello::readWorld(opt.world, limits);
   } catch (const jello::WorldFileError& e) {
     std::fprintf(stderr, "jello-sim: error: %s\n", e.what());
     return kExitInput;
+  }
+  if (!world.unknownIntegrator.empty()) {
+    std::fprintf(stderr,
+                 "jello-sim: warning: %s names the integrator '%s', unknown here; stepping "
+                 "with --integrator %s\n",
+                 opt.world.c_str(), world.unknownIntegrator.c_str(), opt.integrator.c_str());
   }
   if (opt.cube) world = jello::resampleCube(world, *opt.cube);
 
@@ -224,6 +233,7 @@ int run(const Options& opt) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  jello::ignoreBrokenPipes("jello-sim");
   jello::applySolverThreadSettings(argv);
   // A file-size limit (or a quota) must fail the write, which is reported and cleaned up, not
   // kill the process with a temporary file left behind.
@@ -240,29 +250,29 @@ int main(int argc, char** argv) {
   app.add_option("--integrator", opt.integrator,
                  "Integrator, overriding the file's: " + jello::integratorNameList());
   app.add_option("--dt", opt.dt, "Time step in seconds, overriding the file's")
-      ->check(CLI::PositiveNumber);
+      ->check(jello::cli::positive());
   auto* time = app.add_option("--time", opt.time, "Simulated time to run, s (default 1)")
-                   ->check(CLI::PositiveNumber);
+                   ->check(jello::cli::positive());
   app.add_option("--steps", opt.steps, "Number of steps to run instead of --time")
-      ->check(CLI::NonNegativeNumber)
+      ->check(jello::cli::nonNegative())
       ->excludes(time);
   app.add_option("--cube", opt.cube, "Resample the cube to N^3 points (initial state interpolated)")
-      ->check(CLI::Range(2, 64));
+      ->check(jello::cli::range(2, 64));
   app.add_option("--out", opt.out, "Write the final state as a world file");
   auto* trace = app.add_option("--trace", opt.trace, "Write energies and centre of mass (CSV)");
   app.add_option("--every", opt.every, "Trace every K steps (default 100)")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->needs(trace);
   app.add_option("--stats", opt.stats, "Write the summary as JSON");
   app.add_flag("--quiet,-q", opt.quiet, "Print nothing but errors");
   app.add_option("--max-field-resolution", opt.limits.maxFieldResolution,
                  "Refuse worlds with a larger force field (nodes per axis)")
-      ->check(CLI::Range(2, 1024))
+      ->check(jello::cli::range(2, 1024))
       ->capture_default_str()
       ->group("Limits (checked before memory is allocated)");
   app.add_option("--max-cube-resolution", opt.limits.maxCubeResolution,
                  "Refuse worlds with a larger cube (points per axis)")
-      ->check(CLI::Range(2, 256))
+      ->check(jello::cli::range(2, 256))
       ->capture_default_str()
       ->group("Limits (checked before memory is allocated)");
 
@@ -279,24 +289,24 @@ int main(int argc, char** argv) {
                "Do not clamp compressed springs' Jacobians (the system may be indefinite)")
       ->group(implicitGroup);
   app.add_option("--cg-tol", implicit.cgTolerance, "Relative residual of CG solves")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->capture_default_str()
       ->group(implicitGroup);
   app.add_option("--newton-iters", implicit.newtonMaxIterations,
                  "implicit, midpoint, newmark, bdf2: most Newton iterations per step (a step "
                  "still unconverged is counted and reported)")
-      ->check(CLI::Range(1, 1000))
+      ->check(jello::cli::range(1, 1000))
       ->capture_default_str()
       ->group(implicitGroup);
   app.add_option("--newton-tol", implicit.newtonTolerance,
                  "implicit, midpoint, newmark, bdf2: relative residual that ends the iterations")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->capture_default_str()
       ->group(implicitGroup);
   app.add_option("--newton-xtol", implicit.newtonPositionTolerance,
                  "implicit, midpoint, newmark, bdf2: a Newton update moving no coordinate more "
                  "than this (m) also ends them")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->capture_default_str()
       ->group(implicitGroup);
   app.add_flag("--no-factor-reuse", opt.noFactorReuse,
@@ -306,23 +316,23 @@ int main(int argc, char** argv) {
   app.add_option("--refactor-ratio", implicit.refactorRatio,
                  "implicit, midpoint, newmark, bdf2: factor afresh when an iteration shrinks "
                  "the residual by less than this")
-      ->check(CLI::Range(1e-6, 1.0))
+      ->check(jello::cli::range(1e-6, 1.0))
       ->capture_default_str()
       ->group(implicitGroup);
   auto& projective = opt.solver.projective;
   app.add_option("--projective-iters", projective.iterations,
                  "projective: local/global iterations per step")
-      ->check(CLI::Range(1, 100000))
+      ->check(jello::cli::range(1, 100000))
       ->capture_default_str()
       ->group(implicitGroup);
   app.add_option("--projective-tol", projective.tolerance,
                  "projective: stop a step's iterations early once an update moves no coordinate "
                  "more than this (m; 0: never early)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(jello::cli::nonNegative())
       ->capture_default_str()
       ->group(implicitGroup);
   app.add_option("--rtol", cvode.rtol, "cvode: relative tolerance")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->capture_default_str()
       ->group(implicitGroup);
   app.add_option("--cvode-method", opt.cvodeMethod,
@@ -334,29 +344,30 @@ int main(int argc, char** argv) {
   app.add_option("--atol", opt.atol,
                  "cvode: absolute tolerance of positions (m) and velocities (m/s) (default "
                  "1e-3 * rtol)")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->group(implicitGroup);
   app.add_option("--atol-x", cvode.atolPosition, "cvode: absolute tolerance of positions (m)")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->group(implicitGroup);
   app.add_option("--atol-v", cvode.atolVelocity, "cvode: absolute tolerance of velocities (m/s)")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->group(implicitGroup);
   app.add_flag("--contact-roots", cvode.contactRoots,
                "cvode: locate contact onset and release as roots and restart there")
       ->group(implicitGroup);
   app.add_option("--max-order", cvode.maxOrder, "cvode: largest BDF order")
-      ->check(CLI::Range(1, 5))
+      ->check(jello::cli::range(1, 5))
       ->capture_default_str()
       ->group(implicitGroup);
   app.add_flag("--no-stab-lim-det", opt.noStabLimDet,
                "cvode: switch off BDF stability-limit detection")
       ->group(implicitGroup);
   app.add_option("--max-step", cvode.maxStep, "cvode: largest internal step, s (default none)")
-      ->check(CLI::PositiveNumber)
+      ->check(jello::cli::positive())
       ->group(implicitGroup);
   try {
     app.parse(argc, argv);
+    jello::refuseNonFiniteNumbers(app);
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : kExitUsage;
