@@ -106,7 +106,10 @@ def table_from_csv():
     for r in rows:
         newton = r["newton_iterations_per_step"]
         newton = f"{float(newton):.1f}" if newton else "n/a"
-        lines.append(f"| `{r['integrator']}` | {float(r['dt_s']):g} | "
+        name = f"`{r['integrator']}`"
+        if r["diverged"] not in ("", "0", "False", "false"):
+            name += f" (diverged at t = {float(r['simulated_s']):.3g} s; figures there)"
+        lines.append(f"| {name} | {float(r['dt_s']):g} | "
                      f"{float(r['energy_kept']):.4g} | {float(r['angular_momentum_kept']):.4g} | "
                      f"{float(r['wall_time_s']):.3g} s | "
                      f"{float(r['wall_time_per_step_ms']):.3g} ms | {newton} |")
