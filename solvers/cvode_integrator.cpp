@@ -9,6 +9,8 @@
 #include <iterator>
 #include <string>
 
+#include "src/interrupt.h"
+
 namespace jello {
 namespace {
 
@@ -18,6 +20,13 @@ CvodeIntegrator& self(void* data) {
 
 int rhsTrampoline(sunrealtype, N_Vector y, N_Vector ydot, void* data) {
   return self(data).rightHandSide(N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
+}
+
+// SUNDIALS' own messages: kept for our error message instead of printed raw to stderr.
+void errorHandler(int code, const char* module, const char* function, char* message, void* data) {
+  if (code >= 0) return;  // warnings: the statistics say what happened
+  self(data).noteSundialsMessage(std::string(module ? module : "?") + "." +
+                                 (function ? function : "?") + ": " + (message ? message : ""));
 }
 
 int rootTrampoline(sunrealtype, N_Vector y, sunrealtype* g, void* data) {
@@ -139,6 +148,9 @@ StepResult CvodeIntegrator::start(const Model& model, const State& s) {
   cvode_.reset(CVodeCreate(adams ? CV_ADAMS : CV_BDF, context_.get()));
   if (!cvode_) return StepResult::failure("CVodeCreate failed");
   void* mem = cvode_.get();
+  if (int f = CVodeSetErrHandlerFn(mem, errorHandler, this); f != CV_SUCCESS) {
+    return StepResult::failure(cvodeError("CVodeSetErrHandlerFn", f));
+  }
   const double fallback = 1e-3 * options_.rtol;
   double* atol = N_VGetArrayPointer(atol_.get());
   std::fill(atol, atol + n3_, options_.atolPosition > 0.0 ? options_.atolPosition : fallback);
@@ -200,9 +212,18 @@ StepResult CvodeIntegrator::step(const Model& model, State& s, double h) {
   }
   const double tout = s.t + h;
   sunrealtype reached = s.t;
+  sundialsMessage_.clear();
   for (;;) {
     const int flag = CVode(cvode_.get(), tout, y_.get(), &reached, CV_NORMAL);
-    if (flag < 0) return StepResult::failure(cvodeError("CVode", flag));
+    if (flag < 0 && interruptRequested()) {
+      restartPending_ = true;  // CVODE's state is mid-step: start afresh if stepped again
+      return StepResult::interruption();  // s is still the output interval's start
+    }
+    if (flag < 0) {
+      std::string why = cvodeError("CVode", flag);
+      if (!sundialsMessage_.empty()) why += " (" + sundialsMessage_ + ")";
+      return StepResult::failure(why);
+    }
     if (flag != CV_ROOT_RETURN || reached >= tout) break;
     // A contact began or ended at `reached`: the force's derivative jumps there, so the
     // history of the multistep method is restarted from the located state.
@@ -223,6 +244,9 @@ StepResult CvodeIntegrator::step(const Model& model, State& s, double h) {
 }
 
 int CvodeIntegrator::rightHandSide(const double* y, double* ydot) {
+  // A stop requested inside a long output interval: an unrecoverable "failure" ends CVode()
+  // at once, and step() reports it as an interruption.
+  if (interruptRequested()) return -1;
   std::memcpy(ydot, y + n3_, static_cast<std::size_t>(n3_) * sizeof(double));
   x_ = Eigen::Map<const Eigen::VectorXd>(y, n3_) + shift_;
   model_->acceleration(x_.data(), y + n3_, ydot + n3_);

@@ -19,6 +19,7 @@
 
 #include <array>
 #include <memory>
+#include <string>
 
 #include "solvers/implicit_system.h"
 #include "solvers/integrator.h"
@@ -43,6 +44,7 @@ class CvodeIntegrator final : public Integrator {
   int setupSolver();
   int solve(const double* b, double* x);
   int contactDepths(const double* y, double* g);
+  void noteSundialsMessage(std::string message) { sundialsMessage_ = std::move(message); }
   int numRootFunctions() const;
 
   static constexpr std::size_t kNumCounters = 6;
@@ -74,6 +76,7 @@ class CvodeIntegrator final : public Integrator {
   double t_ = 0.0;                 // CVODE's time, to notice a state changed from outside
   long restarts_ = 0, roots_ = 0;
   std::array<long, kNumCounters> carried_{};
+  std::string sundialsMessage_;  // SUNDIALS' last error message, for ours
   bool restartPending_ = false;  // the model's forces changed from outside
 };
 

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include "src/interrupt.h"
+
 namespace jello {
 namespace {
 
@@ -101,6 +103,7 @@ StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
       break;
     }
     if (iterations >= options_.newtonMaxIterations) break;
+    if (interruptRequested()) return StepResult::interruption();  // s is still the start
     ++iterations;
     // Newton: (h^2/gamma) J delta = -(h^2/gamma) r. x_e, v_e are those of d_ (evaluate).
     rhs_ = (-h * h / form.gamma) * r_;

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "src/assertions.h"
+#include "src/interrupt.h"
 
 namespace jello {
 namespace {
@@ -147,6 +148,7 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
   x_ = y_;
   int iterations = 0;
   for (; iterations < options_.iterations; ++iterations) {
+    if (interruptRequested()) return StepResult::interruption();  // s is still the start
     // Local step inside the force evaluation; damping, field and user force at the iterate.
     v_ = (x_ - s.x) / h;
     model.forces(x_, v_, f_);

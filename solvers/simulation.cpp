@@ -76,6 +76,13 @@ StepResult Simulation::step() {
                  "the state handed to a step is finite");
   previous_ = state_;
   StepResult result = integrator_->step(model_, state_, dt_);
+  if (result.interrupted) {
+    // Asked to stop inside the step: nothing diverged; the state is the step's start, and the
+    // integrator starts afresh if stepped again (its step was cut short).
+    state_ = previous_;
+    integrator_->restart();
+    return result;
+  }
   // The speed at which one point alone would hold the whole energy budget.
   const double speedBound =
       std::sqrt(2.0 * (energyBudget() + std::max(0.0, externalWork_)) / model_.mass());

@@ -8,9 +8,13 @@ namespace jello {
 struct [[nodiscard]] StepResult {
   bool ok = true;
   std::string message;  // why, when !ok
+  // Not a failure of the numerics: a stop was requested (src/interrupt.h) inside the step,
+  // which left the state as it was before the step.
+  bool interrupted = false;
 
   static StepResult success() { return {}; }
-  static StepResult failure(std::string why) { return {false, std::move(why)}; }
+  static StepResult failure(std::string why) { return {false, std::move(why), false}; }
+  static StepResult interruption() { return {false, "interrupted", true}; }
 };
 
 }  // namespace jello

@@ -119,4 +119,27 @@ void writeFileAtomically(const std::filesystem::path& path, std::string_view con
   tmp.commit();
 }
 
+std::string outputProblem(const std::filesystem::path& path) {
+  if (path.empty()) return "the output path is empty";
+  std::error_code ec;
+  const std::filesystem::path target = std::filesystem::weakly_canonical(path, ec);
+  const std::filesystem::path& file = ec ? path : target;
+  const auto status = std::filesystem::status(file, ec);
+  if (std::filesystem::is_directory(status)) return "it is a directory";
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    // A device, FIFO or socket is written in place.
+    return ::access(file.c_str(), W_OK) == 0 ? "" : std::strerror(errno);
+  }
+  std::filesystem::path dir = file.parent_path();
+  if (dir.empty()) dir = ".";
+  if (!std::filesystem::is_directory(dir, ec)) {
+    return "the directory " + dir.string() + " does not exist";
+  }
+  // The temporary file is created in the directory, then renamed: it must be writable.
+  if (::access(dir.c_str(), W_OK | X_OK) != 0) {
+    return "the directory " + dir.string() + " is not writable (" + std::strerror(errno) + ")";
+  }
+  return "";
+}
+
 }  // namespace jello

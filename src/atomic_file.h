@@ -14,11 +14,17 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 #include <string_view>
 
 namespace jello {
 
 // Throws std::runtime_error naming the path and the system's reason.
 void writeFileAtomically(const std::filesystem::path& path, std::string_view contents);
+
+// Why writeFileAtomically(path, ...) would fail for a reason known before the contents exist
+// (an empty path, a directory, a missing or unwritable directory, an unwritable special file),
+// or an empty string: for programs to check every output before a long run.
+std::string outputProblem(const std::filesystem::path& path);
 
 }  // namespace jello

@@ -4,6 +4,8 @@
 #include <sys/sysmacros.h>
 #include <sys/wait.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -151,6 +153,60 @@ TEST(JelloSim, StopsCleanlyOnSigintAndWritesNoWorld) {
   // The trace ends with a complete row at or before the step where it stopped.
   const std::string csv = test::readFile(trace);
   EXPECT_EQ(csv.back(), '\n');
+}
+
+TEST(JelloSim, SigtermInsideOneLongStepStopsWithinASecond) {
+  // One output interval of cvode (--dt 5, rtol 1e-9) on the stiff cube takes minutes, and so
+  // does one projective step of 100,000 iterations: SIGTERM after one second must stop either
+  // within about a second more, with the statistics written and nothing counted as diverged.
+  const std::pair<const char*, const char*> runs[] = {
+      {"cvode", " --dt 5 --time 5 --rtol 1e-9"},
+      {"projective", " --dt 0.01 --time 100 --projective-iters 100000"}};
+  for (const auto& [integrator, options] : runs) {
+    test::TempDir dir;
+    const auto stats = dir.path() / "s.json";
+    const auto start = std::chrono::steady_clock::now();
+    const Outcome r =
+        run("timeout --preserve-status -s TERM 1 " + sim() + " " + world("stiff-k1e5.w") +
+            " --integrator " + integrator + options + " --stats " + stats.string() + " 2>&1");
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(r.code, 128 + SIGTERM) << integrator << "\n" << r.output;
+    EXPECT_LT(seconds, 3.0) << integrator;  // 1 s before the signal, then at most ~2 s
+    EXPECT_FALSE(contains(r.output, "diverged")) << r.output;
+    const auto json = nlohmann::json::parse(test::readFile(stats));
+    EXPECT_EQ(json["interrupted"], true) << integrator;
+  }
+}
+
+TEST(JelloSim, ChecksEveryOutputBeforeTheRunAndWritesEveryOneItCan) {
+  test::TempDir dir;
+  const auto stats = dir.path() / "s.json", trace = dir.path() / "t.csv";
+  // A missing directory, an empty path, a directory, two outputs to one file: refused before
+  // the (long) run, each named.
+  const Outcome r = run(sim() + " " + world("jello.w") + " --time 1000 --stats " +
+                        (dir.path() / "missing" / "s.json").string() + " --trace '' 2>&1");
+  EXPECT_EQ(r.code, 1) << r.output;  // an I/O failure, found before the run
+  EXPECT_TRUE(contains(r.output, "(--stats): the directory")) << r.output;
+  EXPECT_TRUE(contains(r.output, "does not exist")) << r.output;
+  EXPECT_TRUE(contains(r.output, "(--trace): the output path is empty")) << r.output;
+  const Outcome same = run(sim() + " " + world("jello.w") + " --steps 5 --out " + stats.string() +
+                           " --stats " + stats.string() + " 2>&1");
+  EXPECT_EQ(same.code, 1) << same.output;
+  EXPECT_TRUE(contains(same.output, "name the same file")) << same.output;
+  const Outcome directory =
+      run(sim() + " " + world("jello.w") + " --steps 5 --stats " + dir.path().string() + " 2>&1");
+  EXPECT_EQ(directory.code, 1) << directory.output;
+  EXPECT_TRUE(contains(directory.output, "it is a directory")) << directory.output;
+  // At the end, an output that cannot be written (the trace, past a 4 kB file-size limit) is
+  // reported, and the others are still written.
+  const Outcome limited = run("bash -c 'ulimit -f 4; " + sim() + " " + world("jello.w") +
+                              " --steps 400 --every 1 --trace " + trace.string() + " --stats " +
+                              stats.string() + "' 2>&1");
+  EXPECT_EQ(limited.code, 1) << limited.output;
+  EXPECT_TRUE(contains(limited.output, trace.string())) << limited.output;
+  EXPECT_TRUE(std::filesystem::exists(stats));
+  EXPECT_FALSE(std::filesystem::exists(trace));
 }
 
 TEST(JelloSim, AFullDiskLeavesThePreviousFileIntactAndSaysSo) {

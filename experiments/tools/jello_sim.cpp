@@ -12,6 +12,9 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
 
 #include "experiments/common/progress.h"
 #include "experiments/common/signal_handler.h"
@@ -19,6 +22,7 @@
 #include "solvers/solver_threads.h"
 #include "src/atomic_file.h"
 #include "src/finite_options.h"
+#include "src/interrupt.h"
 #include "src/scene_builder.h"
 #include "src/world_reader.h"
 #include "src/world_writer.h"
@@ -36,6 +40,7 @@ volatile std::sig_atomic_t interruptSignal = 0;
 
 extern "C" void onInterrupt(int signo) {
   interruptSignal = signo;
+  jello::requestInterrupt(signo);  // polled inside long steps too (src/interrupt.h)
 }
 
 struct Options {
@@ -46,6 +51,7 @@ struct Options {
   std::optional<long> steps;
   std::optional<int> cube;
   std::string out, trace, stats;
+  bool outGiven = false, traceGiven = false, statsGiven = false;  // even as an empty string
   long every = 100;
   bool quiet = false;
   jello::SolverOptions solver;
@@ -87,6 +93,34 @@ class Trace {
 };
 
 int run(const Options& opt) {
+  // Every output is checked before the run: a bad --stats path must not be found after an
+  // hour. Two outputs to one file would overwrite each other.
+  {
+    std::vector<std::pair<const char*, std::string>> outputs;
+    const std::tuple<const char*, const std::string*, bool> flags[] = {
+        {"--out", &opt.out, opt.outGiven},
+        {"--stats", &opt.stats, opt.statsGiven},
+        {"--trace", &opt.trace, opt.traceGiven}};
+    for (const auto& [flag, path, given] : flags) {
+      if (given) outputs.emplace_back(flag, *path);
+    }
+    bool bad = false;
+    for (std::size_t i = 0; i < outputs.size(); ++i) {
+      if (const std::string why = jello::outputProblem(outputs[i].second); !why.empty()) {
+        std::fprintf(stderr, "jello-sim: error: cannot write %s (%s): %s\n",
+                     outputs[i].second.c_str(), outputs[i].first, why.c_str());
+        bad = true;
+      }
+      for (std::size_t j = 0; j < i; ++j) {
+        if (!outputs[i].second.empty() && outputs[i].second == outputs[j].second) {
+          std::fprintf(stderr, "jello-sim: error: %s and %s name the same file %s\n",
+                       outputs[j].first, outputs[i].first, outputs[i].second.c_str());
+          bad = true;
+        }
+      }
+    }
+    if (bad) return kExitInput;  // an I/O failure, found before the run
+  }
   jello::World world;
   try {
     jello::ReaderLimits limits = opt.limits;
@@ -134,8 +168,8 @@ int run(const Options& opt) {
   jello::setSignalHandler("jello-sim", SIGINT, onInterrupt);
   jello::setSignalHandler("jello-sim", SIGTERM, onInterrupt);
   for (long i = 0; i < total && interruptSignal == 0; ++i) {
-    if (!sim.step().ok) {
-      diverged = true;
+    if (const jello::StepResult r = sim.step(); !r.ok) {
+      diverged = !r.interrupted;  // a stop inside a step leaves the state at its start
       break;
     }
     if (sim.steps() % opt.every == 0) trace.row(sim);
@@ -210,18 +244,26 @@ int run(const Options& opt) {
     }
   }
 
-  try {
-    if (!opt.trace.empty()) jello::writeFileAtomically(opt.trace, trace.text());
-    if (!opt.stats.empty()) jello::writeFileAtomically(opt.stats, stats.dump(2) + "\n");
-    // A diverged or interrupted run saves no world: its last state is not the state at the
-    // requested time. Its trace and stats are complete up to where it stopped, and say so.
-    if (!opt.out.empty() && !diverged && !interrupted) {
-      jello::writeWorld(sim.currentWorld(), opt.out);
+  // Every output that can be written is: one failing does not lose the others.
+  bool writeFailed = false;
+  const auto attempt = [&](auto&& write) {
+    try {
+      write();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "jello-sim: error: %s\n", e.what());
+      writeFailed = true;
     }
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "jello-sim: error: %s\n", e.what());
-    return kExitInput;
+  };
+  if (!opt.trace.empty()) attempt([&] { jello::writeFileAtomically(opt.trace, trace.text()); });
+  if (!opt.stats.empty()) {
+    attempt([&] { jello::writeFileAtomically(opt.stats, stats.dump(2) + "\n"); });
   }
+  // A diverged or interrupted run saves no world: its last state is not the state at the
+  // requested time. Its trace and stats are complete up to where it stopped, and say so.
+  if (!opt.out.empty() && !diverged && !interrupted) {
+    attempt([&] { jello::writeWorld(sim.currentWorld(), opt.out); });
+  }
+  if (writeFailed) return kExitInput;
   if ((diverged || interrupted) && !opt.out.empty()) {
     std::fprintf(stderr, "jello-sim: %s not written (the simulation %s)\n", opt.out.c_str(),
                  diverged ? "diverged" : "was interrupted");
@@ -378,6 +420,9 @@ int main(int argc, char** argv) {
   opt.solver.cvode.cgTolerance = opt.solver.implicit.cgTolerance;
   opt.solver.cvode.stabilityLimitDetection = !opt.noStabLimDet;
   opt.solver.implicit.reuseFactor = !opt.noFactorReuse;
+  opt.outGiven = app.count("--out") > 0;
+  opt.statsGiven = app.count("--stats") > 0;
+  opt.traceGiven = app.count("--trace") > 0;
   opt.solver.cvode.method =
       opt.cvodeMethod == "adams" ? jello::CvodeMethod::Adams : jello::CvodeMethod::Bdf;
   // --atol sets both; --atol-x and --atol-v win over it.
