@@ -384,6 +384,21 @@ TEST(JelloSim, AClosedOutputPipeDoesNotKillTheRun) {
   EXPECT_TRUE(std::filesystem::exists(stats));
 }
 
+TEST(Experiments, RefuseAnUnwritableOutputDirectoryBeforeTheRun) {
+  // Before the fix, a study ran for its whole length and then failed to write.
+  const std::filesystem::path bin = std::filesystem::path(sim()).parent_path();
+  for (const char* program : {"jello-stability", "jello-work-precision", "jello-scaling"}) {
+    if (!std::filesystem::exists(bin / program)) continue;  // not built here
+    const auto start = std::chrono::steady_clock::now();
+    const Outcome r = run((bin / program).string() + " --out-dir /proc/jello-results 2>&1");
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(r.code, 1) << program << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, "/proc/jello-results")) << r.output;
+    EXPECT_LT(seconds, 2.0) << program;  // refused at once, not after the study
+  }
+}
+
 // Every numeric option of every program refuses NaN and infinities with exit code 2, found
 // from each program's own --help, so a new option is covered without being listed here.
 TEST(EveryProgram, RefusesNanAndInfinityInEveryNumericOption) {

@@ -70,19 +70,44 @@ void writeSidecar(const std::filesystem::path& path, const nlohmann::json& sidec
   writeFileAtomically(path, sidecar.dump(2) + "\n");
 }
 
-bool writeResults(const std::string& program, const std::filesystem::path& dir,
-                  const std::string& name, const CsvTable& table, const nlohmann::json& sidecar,
-                  const std::vector<std::pair<std::string, const CsvTable*>>& extra) {
-  try {
-    std::filesystem::create_directories(dir);
-    table.write(dir / (name + ".csv"));
-    for (const auto& [suffix, other] : extra) other->write(dir / (name + "_" + suffix + ".csv"));
-    writeSidecar(dir / (name + ".json"), sidecar);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s: error: %s\n", program.c_str(), e.what());
+bool prepareOutputDirectory(const std::string& program, const std::filesystem::path& dir,
+                            const std::string& name) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) {
+    std::fprintf(stderr, "%s: error: cannot create the output directory %s: %s\n", program.c_str(),
+                 dir.c_str(), ec.message().c_str());
+    return false;
+  }
+  const std::filesystem::path probe = dir / (name + ".csv");
+  if (const std::string why = outputProblem(probe); !why.empty()) {
+    std::fprintf(stderr, "%s: error: cannot write %s: %s\n", program.c_str(), probe.c_str(),
+                 why.c_str());
     return false;
   }
   return true;
+}
+
+bool writeResults(const std::string& program, const std::filesystem::path& dir,
+                  const std::string& name, const CsvTable& table, const nlohmann::json& sidecar,
+                  const std::vector<std::pair<std::string, const CsvTable*>>& extra) {
+  // Every file that can be written is; each failure is reported.
+  bool ok = true;
+  const auto attempt = [&](auto&& write) {
+    try {
+      write();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "%s: error: %s\n", program.c_str(), e.what());
+      ok = false;
+    }
+  };
+  attempt([&] { std::filesystem::create_directories(dir); });
+  attempt([&] { table.write(dir / (name + ".csv")); });
+  for (const auto& [suffix, other] : extra) {
+    attempt([&] { other->write(dir / (name + "_" + suffix + ".csv")); });
+  }
+  attempt([&] { writeSidecar(dir / (name + ".json"), sidecar); });
+  return ok;
 }
 
 }  // namespace jello::experiments

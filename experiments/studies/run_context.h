@@ -16,8 +16,14 @@ namespace jello::experiments {
 nlohmann::json runContext(int argc, char** argv);
 void writeSidecar(const std::filesystem::path& path, const nlohmann::json& sidecar);
 
+// Creates `dir` and checks that NAME.csv can be written there, before a long run: false, with
+// the reason on stderr naming `program`, when not.
+bool prepareOutputDirectory(const std::string& program, const std::filesystem::path& dir,
+                            const std::string& name);
+
 // Writes `table` to DIR/NAME.csv, each of `extra` to DIR/NAME_<suffix>.csv and the sidecar
-// to DIR/NAME.json, creating DIR. On failure prints "<program>: error: ..." and returns false.
+// to DIR/NAME.json, creating DIR. Every file that can be written is; on any failure prints
+// "<program>: error: ..." for each and returns false.
 bool writeResults(const std::string& program, const std::filesystem::path& dir,
                   const std::string& name, const CsvTable& table, const nlohmann::json& sidecar,
                   const std::vector<std::pair<std::string, const CsvTable*>>& extra = {});

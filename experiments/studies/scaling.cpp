@@ -84,6 +84,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  // The output directory is made and checked before the (long) run.
+  if (!prepareOutputDirectory("jello-scaling", outDir, name)) return 1;
   if (quick) {
     if (app.count("--n") == 0) ns = {6, 8};
     if (app.count("--budget") == 0) budget = 0.3;

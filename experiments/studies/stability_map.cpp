@@ -99,6 +99,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  // The output directory is made and checked before the (long) run.
+  if (!prepareOutputDirectory("jello-stability", opt.outDir, opt.name)) return 1;
   std::vector<IntegratorKind> kinds;
   for (const std::string& name : opt.integrators) {
     const auto kind = parseIntegratorName(name);

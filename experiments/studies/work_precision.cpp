@@ -118,6 +118,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  // The output directory is made and checked before the (long) run.
+  if (!prepareOutputDirectory("jello-work-precision", outDir, name)) return 1;
   if (quick && app.count("--levels") == 0) levels = 3;
   const std::vector<double> rtols =
       quick ? std::vector<double>{1e-3, 1e-5, 1e-7}
