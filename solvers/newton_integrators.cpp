@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "src/interrupt.h"
 
@@ -69,10 +70,15 @@ double NewtonIntegrator::merit(const Model& model, double inertia, const Eigen::
   return e;
 }
 
+// The a and b of A = M - a D - b K for the current form: (sigma, theta) h^2/gamma.
+std::pair<double, double> NewtonIntegrator::matrixCoefficients(double h) const {
+  const double scale = h * h / form_.gamma;
+  return {form_.sigma * scale, form_.theta * scale};
+}
+
 StepResult NewtonIntegrator::prepareNewtonMatrix(double h, bool refactor) {
   system_.assemble(xe_.data());
-  const double scale = h * h / form_.gamma;
-  const double a = form_.sigma * scale, b = form_.theta * scale;
+  const auto [a, b] = matrixCoefficients(h);
   if (!refactor && factorValid_ && a == factorA_ && b == factorB_) {
     ++reuses_;
     return StepResult::success();
@@ -183,8 +189,8 @@ SparseMatrix NewtonIntegrator::newtonMatrix(const Model& model, const State& sta
   form(model, start, h, form_);
   evaluate(model, form_.gamma / (h * h), y - start.x);
   system_.assemble(xe_.data());
-  const double scale = h * h / form_.gamma;
-  system_.formMatrix(form_.sigma * scale, form_.theta * scale);
+  const auto [a, b] = matrixCoefficients(h);
+  system_.formMatrix(a, b);
   factorValid_ = false;  // A now differs from what was factored
   return system_.A() * (form_.gamma / (h * h));
 }

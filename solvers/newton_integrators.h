@@ -45,6 +45,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <utility>
 
 #include "solvers/implicit_system.h"
 #include "solvers/integrator.h"
@@ -97,6 +98,7 @@ class NewtonIntegrator : public Integrator {
   // Assembles K and D at the iterate and, when `refactor`, factors
   // A = M - (sigma h^2/gamma) D - (theta h^2/gamma) K there.
   StepResult prepareNewtonMatrix(double h, bool refactor);
+  std::pair<double, double> matrixCoefficients(double h) const;
 
   ImplicitOptions options_;
   ImplicitSystem system_;

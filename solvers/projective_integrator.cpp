@@ -173,7 +173,8 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
       delta_.resize(n, 3);
       for (int c = 0; c < 3; ++c) {
         auto& llt = factors_->llt[factorOf_[c]];
-        delta_.col(c) = llt.solve(Eigen::VectorXd(-r.col(c)));
+        column_ = -r.col(c);  // reused: no allocation per iteration
+        delta_.col(c) = llt.solve(column_);
         if (llt.info() != Eigen::Success) return StepResult::failure("the CHOLMOD solve failed");
       }
     }

@@ -70,7 +70,7 @@ class ProjectiveIntegrator final : public Integrator {
   struct Factors;                           // CHOLMOD's, one per distinct matrix
   std::unique_ptr<Factors> factors_;
   bool factored_ = false;
-  Eigen::VectorXd y_, x_, v_, f_, r_;
+  Eigen::VectorXd y_, x_, v_, f_, r_, column_;
   Eigen::MatrixXd delta_;  // n x 3, the update of each coordinate
   int lastIterations_ = 0;
   double lastUpdate_ = 0.0;
