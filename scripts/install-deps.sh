@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libspectra-dev libcli11-dev nlohmann-json3-dev gnuplot-nox
   clang-14 libclang-rt-14-dev clang-format-14
+  python3 python3-dev pybind11-dev python3-numpy python3-scipy python3-matplotlib python3-pytest
 )
 
 missing=()

@@ -25,7 +25,9 @@ class Integrator {
  public:
   virtual ~Integrator() = default;
   virtual IntegratorKind kind() const = 0;
-  // Advances state.x, state.v and state.t by h seconds.
+  // Advances state.x, state.v and state.t by h seconds, writing into the state's vectors in
+  // place: never resized, swapped or moved, so views of them (the Python module's numpy
+  // arrays) stay valid.
   virtual StepResult step(const Model& model, State& state, double h) = 0;
   virtual std::vector<Statistic> statistics() const { return {}; }
   // The model's forces changed from outside (a user force was set): an integrator that carries

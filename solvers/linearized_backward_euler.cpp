@@ -67,8 +67,8 @@ StepResult LinearizedBackwardEuler::step(const Model& model, State& s, double h)
   lastIterations_ = iterations;
   newtonIterations_ += iterations;
   ++steps_;
-  s.x.swap(x1_);
-  s.v.swap(v1_);
+  s.x = x1_;  // copied, not swapped: the state's storage stays put (Integrator::step)
+  s.v = v1_;
   s.t += h;
   return StepResult::success();
 }

@@ -192,7 +192,7 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
   iterations_ += iterations;
   ++steps_;
   s.v = (x_ - s.x) / h;
-  s.x.swap(x_);
+  s.x = x_;  // copied, not swapped: the state's storage stays put (Integrator::step)
   s.t += h;
   return StepResult::success();
 }

@@ -44,7 +44,7 @@ double Simulation::energyBudget() const {
 }
 
 std::optional<std::string> Simulation::energyGrowth() {
-  const double now = model_.energy(state_).total() - externalWork_;
+  const double now = model_.energy(state_).total() - externalWork();
   if (now <= energyBudget()) return std::nullopt;
   std::ostringstream os;
   os << "the energy grew to " << now << " J (energy bound " << kEnergyGrowthFactor
@@ -85,15 +85,15 @@ StepResult Simulation::step() {
   }
   // The speed at which one point alone would hold the whole energy budget.
   const double speedBound =
-      std::sqrt(2.0 * (energyBudget() + std::max(0.0, externalWork_)) / model_.mass());
+      std::sqrt(2.0 * (energyBudget() + std::max(0.0, externalWork())) / model_.mass());
   std::optional<std::string> broken = result.ok
                                           ? findDivergence(state_, kDivergenceBound, speedBound)
                                           : std::optional<std::string>(result.message);
   ++steps_;
   if (!broken) {
     // The work of the forces no potential describes, only for scenes that have them.
-    if (model_.hasField()) externalWork_ += model_.fieldWork(previous_.x.data(), state_.x.data());
-    if (model_.hasUserForce()) externalWork_ += model_.userForceWork(previous_.x, state_.x);
+    if (model_.hasField()) fieldWork_ += model_.fieldWork(previous_.x.data(), state_.x.data());
+    if (model_.hasUserForce()) userWork_ += model_.userForceWork(previous_.x, state_.x);
     if (steps_ % kEnergyCheckInterval == 0) broken = energyGrowth();
   }
   if (!broken) return result;
@@ -104,6 +104,19 @@ StepResult Simulation::step() {
 
 void Simulation::setIntegrator(IntegratorKind kind) {
   if (kind != integrator_->kind()) integrator_ = makeIntegrator(kind, options_);
+}
+
+void Simulation::setIntegrator(IntegratorKind kind, const SolverOptions& options) {
+  options_ = options;
+  integrator_ = makeIntegrator(kind, options_);
+}
+
+void Simulation::stateEdited() {
+  JELLO_ASSERT(state_.x.size() == 3 * model_.numPoints() && state_.v.size() == state_.x.size(),
+               "an edited state keeps its size");
+  integrator_->restart();
+  if (divergence_ && !findDivergence(state_)) divergence_.reset();
+  energyStart_ = std::max(0.0, model_.energy(state_).total() - externalWork());
 }
 
 void Simulation::setTimeStep(double dt) {

@@ -55,6 +55,15 @@ class Simulation {
 
   // Switches the integrator, keeping the state.
   void setIntegrator(IntegratorKind kind);
+  // The same with other solver options (a new integrator even when the kind is the same).
+  void setIntegrator(IntegratorKind kind, const SolverOptions& options);
+  // The state, for editing in place (the Python module's numpy views write into it). Its
+  // vectors must keep their size. Call stateEdited() after a change, before the next step.
+  State& editableState() { return state_; }
+  // The state was changed from outside: the integrator starts afresh (no history, as after a
+  // user force), the energy rule takes the new energy as its start, and a divergence is
+  // forgotten when the state is sane again.
+  void stateEdited();
   void setTimeStep(double dt);
   // A force from outside the world (the viewer's drag), N per point, 3n component-major;
   // cleared with clearUserForce.
@@ -69,6 +78,12 @@ class Simulation {
   double dt() const { return dt_; }
   long steps() const { return steps_; }
   const std::optional<Divergence>& divergence() const { return divergence_; }
+  const SolverOptions& solverOptions() const { return options_; }
+  // Work (J) the force field and the user force have done on the points since the start, by
+  // the trapezoid rule along each step (Model::fieldWork): minus it is their share of the
+  // energy balance, so kinetic + spring + contact - work is what damping alone changes.
+  double fieldWork() const { return fieldWork_; }
+  double userForceWork() const { return userWork_; }
 
   // The world with the current state as its initial state (what --out saves).
   World currentWorld() const;
@@ -85,7 +100,9 @@ class Simulation {
   std::optional<Divergence> divergence_;
   // The energy rule: the budget's start, and the work done by the field and the user force.
   double energyStart_ = 0.0;
-  double externalWork_ = 0.0;
+  double fieldWork_ = 0.0;
+  double userWork_ = 0.0;
+  double externalWork() const { return fieldWork_ + userWork_; }
   std::optional<std::string> energyGrowth();
   double energyBudget() const;
 };
