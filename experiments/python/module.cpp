@@ -604,12 +604,19 @@ class PySimulation {
     Busy busy(*this);
     checkEdits();
     sim_.setIntegrator(integratorFrom(name), solverOptionsFrom(options, sim_.solverOptions()));
+    forgiveDivergence();
+  }
+
+  // Another integrator or step may well not diverge from the last sane state: it may try.
+  void forgiveDivergence() {
+    if (sim_.divergence()) sim_.stateEdited();
   }
 
   void setDt(double dt) {
     Busy busy(*this);
     checkEdits();
     sim_.setTimeStep(positive(dt, "dt"));
+    forgiveDivergence();
   }
 
   void setUserForce(const py::object& f) {
@@ -951,8 +958,14 @@ PYBIND11_MODULE(_core, m) {
           "Angular momentum about the centre of mass (kg m^2/s)")
       .def_property_readonly("stats", &PySimulation::stats,
                              "The summary jello-sim --stats writes, as a dict")
-      .def_property_readonly("diverged",
-                             [](const PySimulation& s) { return s.sim().divergence().has_value(); })
+      .def_property_readonly(
+          "diverged",
+          [](PySimulation& s) {
+            s.noticeEdits();  // a sane state written through a view clears a divergence
+            return s.sim().divergence().has_value();
+          },
+          "True after a divergence, until the state is edited, the integrator switched or dt "
+          "changed")
       .def("set_integrator", &PySimulation::setIntegrator, "name"_a,
            "Switches the integrator, keeping the state; keywords change solver options (the "
            "others stay as they were).")
@@ -975,8 +988,10 @@ PYBIND11_MODULE(_core, m) {
           },
           "positions"_a = py::none(), "clamp"_a = false, "field"_a = true,
           "(K, D) = (df/dx, df/dv) as 3n x 3n scipy.sparse.csr_matrix, component-major (row "
-          "c*n + p: component c of point p). Exact by default; clamp=True gives the "
-          "implicit solvers' clamped K, field=False leaves out the field's gradient.")
+          "c*n + p: component c of point p). Exact by default but for the damping forces' "
+          "dependence on x, which is left out (src/PHYSICS.md; it vanishes at v = 0); "
+          "clamp=True gives the implicit solvers' clamped K, field=False leaves out the "
+          "field's gradient.")
       .def(
           "world",
           [](PySimulation& s) {
