@@ -80,8 +80,7 @@ std::string cvodeError(const char* call, int flag) {
 }  // namespace
 
 CvodeIntegrator::CvodeIntegrator(CvodeOptions options)
-    : options_(options),
-      system_(options.linearSolver, options.cgTolerance, options.clampCompression) {}
+    : options_(options), system_(options.linearSolverOptions(), options.clampCompression) {}
 
 CvodeIntegrator::~CvodeIntegrator() {
   // CVODE first (it refers to the solvers, matrix and vectors), the context last.

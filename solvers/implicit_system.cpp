@@ -6,14 +6,16 @@
 
 namespace jello {
 
-ImplicitSystem::ImplicitSystem(LinearSolverKind linearSolver, double cgTolerance,
-                               bool clampCompression)
-    : clampCompression_(clampCompression), solver_(linearSolver, cgTolerance) {}
+ImplicitSystem::ImplicitSystem(const LinearSolverOptions& linearSolver, bool clampCompression)
+    : clampCompression_(clampCompression),
+      matrixFree_(linearSolver.kind == LinearSolverKind::Cg && linearSolver.matrixFree),
+      solver_(linearSolver) {}
 
 bool ImplicitSystem::bind(const Model& model) {
   if (model.id() == modelId_) return false;
   modelId_ = model.id();
   jacobian_ = std::make_unique<JacobianAssembler>(model);
+  if (matrixFree_) operator_ = std::make_unique<SystemOperator>(model.springs(), model.numPoints());
   A_ = jacobian_->pattern();
   solver_.forgetPattern();
   return true;
@@ -32,7 +34,8 @@ void ImplicitSystem::formMatrix(double a, double b) {
 }
 
 StepResult ImplicitSystem::factorize() {
-  return solver_.factorize(A_);
+  if (operator_) operator_->gather(A_, jacobian_->diagonalSlots(), jacobian_->springSlots());
+  return solver_.factorize(A_, operator_.get());
 }
 
 StepResult ImplicitSystem::factorize(double a, double b) {
@@ -54,6 +57,11 @@ void ImplicitSystem::appendStatistics(std::vector<Statistic>& out) const {
   out.push_back({"solve_time_s", ls.solveSeconds});
   if (solver_.kind() == LinearSolverKind::Cg) {
     out.push_back({"cg_iterations", static_cast<double>(ls.cgIterations)});
+    if (solver_.preconditioner() == PreconditionerKind::IncompleteCholesky ||
+        solver_.preconditioner() == PreconditionerKind::Factor) {
+      out.push_back(
+          {"preconditioner_factorizations", static_cast<double>(ls.preconditionerFactorizations)});
+    }
   }
 }
 

@@ -19,12 +19,13 @@
 #include "solvers/integrator.h"
 #include "solvers/jacobian.h"
 #include "solvers/linear_solver.h"
+#include "solvers/system_operator.h"
 
 namespace jello {
 
 class ImplicitSystem {
  public:
-  ImplicitSystem(LinearSolverKind linearSolver, double cgTolerance, bool clampCompression);
+  ImplicitSystem(const LinearSolverOptions& linearSolver, bool clampCompression);
 
   // Binds to `model`; true when it is another model than the last (the pattern is rebuilt and
   // the solver analyses afresh: integrators must forget their history then).
@@ -35,7 +36,8 @@ class ImplicitSystem {
   void assemble(const double* x);
   // A = M - a D - b K of the last assembly, written into A().
   void formMatrix(double a, double b);
-  // A as formed, factored (CHOLMOD) or prepared (CG).
+  // A as formed, factored (CHOLMOD) or prepared (CG: the preconditioner set up and, matrix-free,
+  // A's blocks gathered for the product; CG then solves with this A until the next factorize).
   StepResult factorize();
   // formMatrix(a, b), then factorize().
   StepResult factorize(double a, double b);
@@ -55,7 +57,9 @@ class ImplicitSystem {
  private:
   bool clampCompression_;
   long modelId_ = -1;
+  bool matrixFree_;
   std::unique_ptr<JacobianAssembler> jacobian_;
+  std::unique_ptr<SystemOperator> operator_;  // cg, matrix-free
   SparseMatrix A_;
   SpdSolver solver_;
   double assembleSeconds_ = 0.0;

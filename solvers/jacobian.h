@@ -40,6 +40,12 @@ class JacobianAssembler {
   void combine(double alpha, double beta, SparseMatrix& A) const;
   const SparseMatrix& pattern() const { return K_; }
 
+  // Where the values of each spring's blocks (a,b), (b,a) (18 per spring, in the order of
+  // SpringForces::springs()) and of each point's diagonal block (9 per point) are in the
+  // pattern's value array: what SystemOperator gathers.
+  const std::vector<int>& springSlots() const { return springSlots_; }
+  const std::vector<int>& diagonalSlots() const { return diagSlots_; }
+
   long lastClampCount() const { return lastClamps_; }  // springs clamped in the last assembly
   long totalClampCount() const { return totalClamps_; }
 

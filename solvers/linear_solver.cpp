@@ -2,7 +2,12 @@
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/IterativeLinearSolvers>
+#include <array>
 #include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "solvers/system_operator.h"
 
 namespace jello {
 namespace {
@@ -18,12 +23,18 @@ constexpr double kResidualTolerance = 1e-8;
 }  // namespace
 
 struct SpdSolver::Impl {
-  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt;
+  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt;  // cholmod; cg's stale factor
   Eigen::CholmodSimplicialLDLT<SparseMatrix, Eigen::Lower> ldlt;
-  Eigen::ConjugateGradient<SparseMatrix, Eigen::Lower | Eigen::Upper,
-                           Eigen::DiagonalPreconditioner<double>>
-      cg;
+  Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::AMDOrdering<int>> ichol;
   bool lltAnalyzed = false;
+  // cg: the operator (or A itself), the preconditioner's data, the work vectors.
+  const SystemOperator* op = nullptr;
+  Eigen::VectorXd invDiagonal;                  // jacobi
+  std::array<Eigen::VectorXd, 6> blockInverse;  // block-jacobi: per point, upper triangle
+  bool staleFactor = false;                     // factor: llt holds an earlier A's factor
+  bool icholAnalyzed = false;
+  int lastIterations = 0;
+  Eigen::VectorXd r, z, p, q;
   bool ldltAnalyzed = false;
   bool useLdlt = false;             // this factorization went to LDLT
   const SparseMatrix* A = nullptr;  // for the residual check
@@ -49,6 +60,54 @@ struct SpdSolver::Impl {
   }
 };
 
+namespace {
+
+// The inverse of each point's symmetric 3x3 block (xx, xy, xz, yy, yz, zz arrays); false when
+// a block is not positive definite.
+bool invertBlocks(const std::array<const double*, 6>& g, Eigen::Index n,
+                  std::array<Eigen::VectorXd, 6>& inv) {
+  for (auto& v : inv) v.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double a = g[0][i], b = g[1][i], c = g[2][i], d = g[3][i], e = g[4][i], f = g[5][i];
+    // Cofactors of [[a b c] [b d e] [c e f]].
+    const double A = d * f - e * e, B = c * e - b * f, C = b * e - c * d;
+    const double det = a * A + b * B + c * C;
+    if (!(a > 0.0 && a * d - b * b > 0.0 && det > 0.0) || !std::isfinite(det)) return false;
+    const double s = 1.0 / det;
+    inv[0][i] = A * s;
+    inv[1][i] = B * s;
+    inv[2][i] = C * s;
+    inv[3][i] = (a * f - c * c) * s;
+    inv[4][i] = (b * c - a * e) * s;
+    inv[5][i] = (a * d - b * b) * s;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<PreconditionerKind> parsePreconditioner(std::string_view name) {
+  if (name == "jacobi") return PreconditionerKind::Jacobi;
+  if (name == "block-jacobi") return PreconditionerKind::BlockJacobi;
+  if (name == "ichol") return PreconditionerKind::IncompleteCholesky;
+  if (name == "factor") return PreconditionerKind::Factor;
+  return std::nullopt;
+}
+
+std::string_view preconditionerName(PreconditionerKind kind) {
+  switch (kind) {
+    case PreconditionerKind::Jacobi:
+      return "jacobi";
+    case PreconditionerKind::BlockJacobi:
+      return "block-jacobi";
+    case PreconditionerKind::IncompleteCholesky:
+      return "ichol";
+    case PreconditionerKind::Factor:
+      return "factor";
+  }
+  return "?";
+}
+
 std::optional<LinearSolverKind> parseLinearSolver(std::string_view name) {
   if (name == "cholmod") return LinearSolverKind::Cholmod;
   if (name == "ldlt") return LinearSolverKind::Ldlt;
@@ -69,18 +128,172 @@ std::string_view linearSolverName(LinearSolverKind kind) {
 }
 
 SpdSolver::SpdSolver(LinearSolverKind kind, double cgTolerance)
-    : kind_(kind), impl_(std::make_unique<Impl>()) {
-  impl_->cg.setTolerance(cgTolerance);
-}
+    : SpdSolver(LinearSolverOptions{kind, cgTolerance}) {}
+
+SpdSolver::SpdSolver(const LinearSolverOptions& options)
+    : kind_(options.kind),
+      preconditioner_(options.preconditioner),
+      cgTolerance_(options.cgTolerance),
+      impl_(std::make_unique<Impl>()) {}
 
 SpdSolver::~SpdSolver() = default;
 
 void SpdSolver::forgetPattern() {
   impl_->lltAnalyzed = false;
   impl_->ldltAnalyzed = false;
+  impl_->icholAnalyzed = false;
+  impl_->staleFactor = false;
 }
 
-StepResult SpdSolver::factorize(const SparseMatrix& A) {
+StepResult SpdSolver::setUpPreconditioner(const SparseMatrix& A) {
+  Impl& s = *impl_;
+  const Eigen::Index n3 = A.rows(), n = n3 / 3;
+  switch (preconditioner_) {
+    case PreconditionerKind::Jacobi: {
+      const Eigen::VectorXd d = A.diagonal();
+      if (!(d.minCoeff() > 0.0)) {
+        return StepResult::failure("Jacobi preconditioner: a diagonal entry is not positive");
+      }
+      s.invDiagonal = d.cwiseInverse();
+      return StepResult::success();
+    }
+    case PreconditionerKind::BlockJacobi: {
+      std::array<Eigen::VectorXd, 6> blocks;  // from A when there is no operator
+      std::array<const double*, 6> g{};
+      if (s.op) {
+        for (int e = 0; e < 6; ++e) g[e] = s.op->diagonalBlocks()[e].data();
+      } else {
+        constexpr int rows[6] = {0, 0, 0, 1, 1, 2}, cols[6] = {0, 1, 2, 1, 2, 2};
+        for (int e = 0; e < 6; ++e) {
+          blocks[e].resize(n);
+          for (Eigen::Index i = 0; i < n; ++i)
+            blocks[e][i] = A.coeff(rows[e] * n + i, cols[e] * n + i);
+          g[e] = blocks[e].data();
+        }
+      }
+      if (!invertBlocks(g, n, s.blockInverse)) {
+        return StepResult::failure("block-Jacobi preconditioner: a block is not positive definite");
+      }
+      return StepResult::success();
+    }
+    case PreconditionerKind::IncompleteCholesky:
+      if (!s.icholAnalyzed) {
+        s.ichol.analyzePattern(A);
+        s.icholAnalyzed = true;
+      }
+      s.ichol.factorize(A);
+      ++stats_.preconditionerFactorizations;
+      if (s.ichol.info() != Eigen::Success) {
+        return StepResult::failure("incomplete Cholesky failed");
+      }
+      return StepResult::success();
+    case PreconditionerKind::Factor:
+      if (s.staleFactor && s.lastIterations <= kStaleFactorIterations) {
+        return StepResult::success();  // the earlier factor still serves
+      }
+      if (!s.lltAnalyzed) {
+        s.llt.analyzePattern(A);
+        ++stats_.analyses;
+        if (s.llt.info() != Eigen::Success) return StepResult::failure("CHOLMOD analysis failed");
+        s.lltAnalyzed = true;
+      }
+      s.llt.factorize(A);
+      ++stats_.preconditionerFactorizations;
+      s.lastIterations = 0;
+      s.staleFactor = s.llt.info() == Eigen::Success;
+      if (!s.staleFactor) {
+        return StepResult::failure(
+            "the preconditioner's factorization failed (not positive definite)");
+      }
+      return StepResult::success();
+  }
+  return StepResult::success();
+}
+
+StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+  Impl& s = *impl_;
+  const Eigen::Index n3 = b.size(), n = n3 / 3;
+  if (x.size() != n3) x.setZero(n3);
+  const auto product = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
+    out.resize(n3);
+    if (s.op) {
+      s.op->apply(v.data(), out.data());
+    } else {
+      out.noalias() = *s.A * v;
+    }
+  };
+  const auto precondition = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+    switch (preconditioner_) {
+      case PreconditionerKind::Jacobi:
+        z = s.invDiagonal.cwiseProduct(r);
+        break;
+      case PreconditionerKind::BlockJacobi: {
+        z.resize(n3);
+        const auto& m = s.blockInverse;
+        for (Eigen::Index i = 0; i < n; ++i) {
+          const double rx = r[i], ry = r[n + i], rz = r[2 * n + i];
+          z[i] = m[0][i] * rx + m[1][i] * ry + m[2][i] * rz;
+          z[n + i] = m[1][i] * rx + m[3][i] * ry + m[4][i] * rz;
+          z[2 * n + i] = m[2][i] * rx + m[4][i] * ry + m[5][i] * rz;
+        }
+        break;
+      }
+      case PreconditionerKind::IncompleteCholesky:
+        z = s.ichol.solve(r);
+        break;
+      case PreconditionerKind::Factor:
+        z = s.llt.solve(r);
+        break;
+    }
+  };
+  const double bNorm = b.norm();
+  if (bNorm == 0.0) {
+    x.setZero();
+    s.lastIterations = 0;
+    return StepResult::success();
+  }
+  const double tolerance = cgTolerance_ * bNorm;
+  const long maxIterations = std::max<long>(10, 2 * n3);
+  product(x, s.q);
+  s.r = b - s.q;
+  double residual = s.r.norm();
+  long it = 0;
+  if (residual > tolerance) {
+    precondition(s.r, s.z);
+    s.p = s.z;
+    double rz = s.r.dot(s.z);
+    while (true) {
+      product(s.p, s.q);
+      const double pq = s.p.dot(s.q);
+      if (!(pq > 0.0)) {
+        s.lastIterations = int(std::min<long>(it, 1 << 30));
+        return StepResult::failure(
+            "CG: the matrix is not positive definite (p.Ap = " + std::to_string(pq) + ")");
+      }
+      const double alpha = rz / pq;
+      x += alpha * s.p;
+      s.r -= alpha * s.q;
+      ++it;
+      residual = s.r.norm();
+      if (residual <= tolerance || it >= maxIterations) break;
+      precondition(s.r, s.z);
+      const double rzNext = s.r.dot(s.z);
+      s.p = s.z + (rzNext / rz) * s.p;
+      rz = rzNext;
+    }
+  }
+  stats_.cgIterations += it;
+  s.lastIterations = int(std::min<long>(it, 1 << 30));
+  if (!(residual <= tolerance)) {
+    std::ostringstream os;
+    os << "CG did not converge in " << it << " iterations (relative residual " << residual / bNorm
+       << ")";
+    return StepResult::failure(os.str());
+  }
+  return StepResult::success();
+}
+
+StepResult SpdSolver::factorize(const SparseMatrix& A, const SystemOperator* op) {
   const auto start = Clock::now();
   Impl& s = *impl_;
   s.A = &A;
@@ -109,8 +322,8 @@ StepResult SpdSolver::factorize(const SparseMatrix& A) {
       result = s.factorLdlt(A, stats_);
       break;
     case LinearSolverKind::Cg:
-      s.cg.compute(A);
-      if (s.cg.info() != Eigen::Success) result = StepResult::failure("CG set-up failed");
+      s.op = op;
+      result = setUpPreconditioner(A);
       break;
   }
   ++stats_.factorizations;
@@ -123,13 +336,7 @@ StepResult SpdSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
   Impl& s = *impl_;
   StepResult result = StepResult::success();
   if (kind_ == LinearSolverKind::Cg) {
-    if (x.size() != b.size()) x.setZero(b.size());
-    x = s.cg.solveWithGuess(b, x);
-    stats_.cgIterations += s.cg.iterations();
-    if (s.cg.info() != Eigen::Success) {
-      result = StepResult::failure("CG did not converge in " + std::to_string(s.cg.iterations()) +
-                                   " iterations (error " + std::to_string(s.cg.error()) + ")");
-    }
+    result = conjugateGradients(b, x);
   } else if (s.useLdlt) {
     x = s.ldlt.solve(b);
     if (s.ldlt.info() != Eigen::Success) {

@@ -6,7 +6,14 @@
 //            the solution is accepted only if its residual |Ax - b| <= 1e-8 |b|. Fallbacks are
 //            counted.
 //   ldlt     CHOLMOD simplicial LDLT, residual-checked the same way.
-//   cg       conjugate gradients with a Jacobi preconditioner, warm-started from x.
+//   cg       preconditioned conjugate gradients, warm-started from x, on the sparse matrix or,
+//            given a SystemOperator, matrix-free through the spring kernels. Preconditioners:
+//              jacobi        the diagonal of A
+//              block-jacobi  each point's 3x3 diagonal block of A, inverted
+//              ichol         incomplete Cholesky of A (Eigen, AMD ordering, shifted if needed)
+//              factor        a CHOLMOD factorization of an earlier A, kept while CG converges
+//                            in few iterations (at most kStaleFactorIterations) and refreshed at
+//                            the next set-up after a solve that needed more
 #pragma once
 
 #include <Eigen/Core>
@@ -21,16 +28,33 @@
 namespace jello {
 
 enum class LinearSolverKind { Cholmod, Ldlt, Cg };
+enum class PreconditionerKind { Jacobi, BlockJacobi, IncompleteCholesky, Factor };
 
 std::optional<LinearSolverKind> parseLinearSolver(std::string_view name);
 std::string_view linearSolverName(LinearSolverKind kind);
+// "jacobi", "block-jacobi", "ichol", "factor".
+std::optional<PreconditionerKind> parsePreconditioner(std::string_view name);
+std::string_view preconditionerName(PreconditionerKind kind);
+
+// A stale factor is refreshed after a solve that took more CG iterations than this.
+inline constexpr int kStaleFactorIterations = 10;
+
+struct LinearSolverOptions {
+  LinearSolverKind kind = LinearSolverKind::Cholmod;
+  double cgTolerance = 1e-6;  // relative residual |A x - b| <= tol |b|
+  PreconditionerKind preconditioner = PreconditionerKind::Jacobi;
+  bool matrixFree = true;  // cg: the product through the spring kernels where it is given
+};
+
+class SystemOperator;
 
 struct LinearSolverStats {
   long analyses = 0;
   long factorizations = 0;
   long solves = 0;
-  long fallbacks = 0;     // LLT failed, LDLT used
-  long cgIterations = 0;  // summed over solves
+  long fallbacks = 0;                     // LLT failed, LDLT used
+  long cgIterations = 0;                  // summed over solves
+  long preconditionerFactorizations = 0;  // ichol and factor: set-ups that factored afresh
   double factorSeconds = 0.0;
   double solveSeconds = 0.0;
 };
@@ -38,23 +62,30 @@ struct LinearSolverStats {
 class SpdSolver {
  public:
   explicit SpdSolver(LinearSolverKind kind, double cgTolerance = 1e-6);
+  explicit SpdSolver(const LinearSolverOptions& options);
   ~SpdSolver();
   SpdSolver(const SpdSolver&) = delete;
   SpdSolver& operator=(const SpdSolver&) = delete;
 
   // Prepares to solve with A; every A passed must have the same pattern until forgetPattern().
-  StepResult factorize(const SparseMatrix& A);
+  // cg: `op`, when given, holds the same A (gathered) and takes the products.
+  StepResult factorize(const SparseMatrix& A, const SystemOperator* op = nullptr);
   // The next factorize analyzes its matrix's pattern afresh (a new model).
   void forgetPattern();
   // x: on entry the initial guess (cg), on return the solution.
   StepResult solve(const Eigen::VectorXd& b, Eigen::VectorXd& x);
 
   LinearSolverKind kind() const { return kind_; }
+  PreconditionerKind preconditioner() const { return preconditioner_; }
   const LinearSolverStats& stats() const { return stats_; }
 
  private:
   struct Impl;
+  StepResult setUpPreconditioner(const SparseMatrix& A);
+  StepResult conjugateGradients(const Eigen::VectorXd& b, Eigen::VectorXd& x);
   LinearSolverKind kind_;
+  PreconditionerKind preconditioner_ = PreconditionerKind::Jacobi;
+  double cgTolerance_;
   std::unique_ptr<Impl> impl_;
   LinearSolverStats stats_;
 };

@@ -5,8 +5,7 @@
 namespace jello {
 
 LinearizedBackwardEuler::LinearizedBackwardEuler(ImplicitOptions options)
-    : options_(options),
-      system_(options.linearSolver, options.cgTolerance, options.clampCompression) {}
+    : options_(options), system_(options.linearSolverOptions(), options.clampCompression) {}
 
 void LinearizedBackwardEuler::prepare(const Model& model) {
   if (system_.bind(model)) dv_.setZero(3 * model.numPoints());

@@ -35,8 +35,7 @@ void midpointForm(const State& s, double h, ImplicitStepForm& f) {
 }  // namespace
 
 NewtonIntegrator::NewtonIntegrator(const ImplicitOptions& options)
-    : options_(options),
-      system_(options.linearSolver, options.cgTolerance, options.clampCompression) {}
+    : options_(options), system_(options.linearSolverOptions(), options.clampCompression) {}
 
 void NewtonIntegrator::bind(const Model& model) {
   const bool rebinding = system_.bound();

@@ -7,6 +7,8 @@ namespace jello {
 
 struct ImplicitOptions {
   LinearSolverKind linearSolver = LinearSolverKind::Cholmod;
+  PreconditionerKind preconditioner = PreconditionerKind::Jacobi;  // cg's
+  bool matrixFree = true;  // cg: products through the spring kernels, not the sparse matrix
   // The converged integrators (implicit, midpoint, newmark, bdf2; solvers/newton_integrators.h).
   int newtonMaxIterations = 30;           // a step still unconverged then is counted, reported
   double newtonTolerance = 1e-8;          // relative residual that ends the iterations
@@ -24,6 +26,10 @@ struct ImplicitOptions {
   double contactNewtonTolerance = 1e-4;
   bool clampCompression = true;  // project each spring's Hessian onto semidefinite matrices
   double cgTolerance = 1e-6;     // relative residual of the CG solves
+
+  LinearSolverOptions linearSolverOptions() const {
+    return {linearSolver, cgTolerance, preconditioner, matrixFree};
+  }
 };
 
 enum class CvodeMethod {
@@ -47,8 +53,14 @@ struct CvodeOptions {
   double maxStep = 0.0;            // s, 0: no limit
   long maxStepsPerCall = 1000000;  // internal steps CVODE may take to reach one output time
   LinearSolverKind linearSolver = LinearSolverKind::Cholmod;
+  PreconditionerKind preconditioner = PreconditionerKind::Jacobi;
+  bool matrixFree = true;
   bool clampCompression = true;
   double cgTolerance = 1e-6;
+
+  LinearSolverOptions linearSolverOptions() const {
+    return {linearSolver, cgTolerance, preconditioner, matrixFree};
+  }
 };
 
 struct ProjectiveOptions {

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "solvers/implicit_system.h"
+#include "solvers/system_operator.h"
 #include "src/scene_builder.h"
 #include "tests/test_support.h"
 
@@ -222,8 +223,21 @@ TEST(ImplicitSystem, SolvesTheMassMinusScaledJacobiansAtTheAssembledState) {
   w.kElastic = 1e4;
   const State s = deformedJello(w);
   const Model model(w), other(w);
-  for (LinearSolverKind kind : {LinearSolverKind::Cholmod, LinearSolverKind::Ldlt}) {
-    ImplicitSystem system(kind, 1e-10, true);
+  std::vector<LinearSolverOptions> solvers = {{LinearSolverKind::Cholmod, 1e-10},
+                                              {LinearSolverKind::Ldlt, 1e-10}};
+  // CG with every preconditioner, matrix-free and through the sparse matrix: the same solution.
+  for (PreconditionerKind pre :
+       {PreconditionerKind::Jacobi, PreconditionerKind::BlockJacobi,
+        PreconditionerKind::IncompleteCholesky, PreconditionerKind::Factor}) {
+    for (bool matrixFree : {true, false}) {
+      solvers.push_back({LinearSolverKind::Cg, 1e-11, pre, matrixFree});
+    }
+  }
+  for (const LinearSolverOptions& options : solvers) {
+    SCOPED_TRACE(std::string(linearSolverName(options.kind)) + " " +
+                 std::string(preconditionerName(options.preconditioner)) +
+                 (options.matrixFree ? " matrix-free" : " csr"));
+    ImplicitSystem system(options, true);
     EXPECT_TRUE(system.bind(model));
     EXPECT_FALSE(system.bind(model));
     system.assemble(s.x.data());
@@ -239,6 +253,27 @@ TEST(ImplicitSystem, SolvesTheMassMinusScaledJacobiansAtTheAssembledState) {
     EXPECT_LT((A * x - rhs).norm(), 1e-10 * rhs.norm());
     EXPECT_TRUE(system.bind(other));  // another model, even one built from the same world
   }
+}
+
+// The matrix-free product through the spring groups equals the sparse matrix's, on a scene
+// with springs under every orientation and contact blocks on the diagonal.
+TEST(SystemOperator, ProductEqualsTheSparseMatrix) {
+  World w = test::loadWorld("jello.w");
+  State s = deformedJello(w);
+  s.x.tail(s.numPoints()).array() -= 2.3;  // the lower layers sink into the floor
+  const Model model(w);
+  JacobianAssembler jac(model);
+  jac.assemble(s.x.data(), {});
+  SparseMatrix A = jac.pattern();
+  jac.combine(0.01, 1e-4, A);
+  SystemOperator op(model.springs(), model.numPoints());
+  op.gather(A, jac.diagonalSlots(), jac.springSlots());
+  const Eigen::VectorXd p = Eigen::VectorXd::Random(s.x.size());
+  Eigen::VectorXd y(p.size());
+  op.apply(p.data(), y.data());
+  const Eigen::VectorXd expected = A * p;
+  EXPECT_LT((y - expected).cwiseAbs().maxCoeff(), 1e-13 * expected.cwiseAbs().maxCoeff());
+  ASSERT_LT(s.x.tail(s.numPoints()).minCoeff(), -2.0);  // some points below the floor
 }
 
 }  // namespace

@@ -56,6 +56,8 @@ struct Options {
   bool quiet = false;
   jello::SolverOptions solver;
   std::string linearSolver = "cholmod";
+  std::string preconditioner = "jacobi";
+  bool csrProduct = false;
   bool noClamp = false, noStabLimDet = false, noFactorReuse = false;
   std::string cvodeMethod = "bdf";
   double atol = 0.0;
@@ -327,6 +329,16 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"cholmod", "ldlt", "cg"}))
       ->capture_default_str()
       ->group(implicitGroup);
+  app.add_option("--preconditioner", opt.preconditioner,
+                 "cg: jacobi, block-jacobi (each point's 3x3 block), ichol (incomplete "
+                 "Cholesky) or factor (a CHOLMOD factor of an earlier matrix, refreshed when CG "
+                 "needs more than 10 iterations)")
+      ->check(CLI::IsMember({"jacobi", "block-jacobi", "ichol", "factor"}))
+      ->capture_default_str()
+      ->group(implicitGroup);
+  app.add_flag("--csr-product", opt.csrProduct,
+               "cg: multiply by the sparse matrix instead of through the spring kernels")
+      ->group(implicitGroup);
   app.add_flag("--no-clamp", opt.noClamp,
                "Do not clamp compressed springs' Jacobians (the system may be indefinite)")
       ->group(implicitGroup);
@@ -416,6 +428,9 @@ int main(int argc, char** argv) {
   }
   const auto linear = *jello::parseLinearSolver(opt.linearSolver);
   opt.solver.implicit.linearSolver = opt.solver.cvode.linearSolver = linear;
+  opt.solver.implicit.preconditioner = opt.solver.cvode.preconditioner =
+      *jello::parsePreconditioner(opt.preconditioner);
+  opt.solver.implicit.matrixFree = opt.solver.cvode.matrixFree = !opt.csrProduct;
   opt.solver.implicit.clampCompression = opt.solver.cvode.clampCompression = !opt.noClamp;
   opt.solver.cvode.cgTolerance = opt.solver.implicit.cgTolerance;
   opt.solver.cvode.stabilityLimitDetection = !opt.noStabLimDet;

@@ -198,7 +198,8 @@ void translateExceptions(std::exception_ptr p) {
 
 // The keywords mirror jello-sim's flags with '_' for '-' (README "From Python").
 constexpr const char* kSolverOptionNames =
-    "linear_solver, clamp, cg_tol, newton_iters, newton_tol, newton_xtol, factor_reuse, "
+    "linear_solver, preconditioner, matrix_free, clamp, cg_tol, newton_iters, newton_tol, "
+    "newton_xtol, factor_reuse, "
     "refactor_ratio, projective_iters, projective_tol, rtol, cvode_method, atol, atol_x, atol_v, "
     "contact_roots, max_order, stab_lim_det, max_step";
 
@@ -217,6 +218,12 @@ jello::SolverOptions solverOptionsFrom(const py::kwargs& kwargs, jello::SolverOp
       const auto kind = jello::parseLinearSolver(as<std::string>(value, name));
       if (!kind) valueError("linear_solver must be 'cholmod', 'ldlt' or 'cg'");
       o.implicit.linearSolver = o.cvode.linearSolver = *kind;
+    } else if (name == "preconditioner") {
+      const auto kind = jello::parsePreconditioner(as<std::string>(value, name));
+      if (!kind) valueError("preconditioner must be 'jacobi', 'block-jacobi', 'ichol' or 'factor'");
+      o.implicit.preconditioner = o.cvode.preconditioner = *kind;
+    } else if (name == "matrix_free") {
+      o.implicit.matrixFree = o.cvode.matrixFree = boolOption(value, name);
     } else if (name == "clamp") {
       o.implicit.clampCompression = o.cvode.clampCompression = boolOption(value, name);
     } else if (name == "cg_tol") {
