@@ -5,6 +5,7 @@
 #include <cstddef>
 
 #include "src/assertions.h"
+#include "src/parallel.h"
 
 namespace jello {
 
@@ -50,6 +51,7 @@ SpringForces::SpringForces(std::vector<SpringGroup> groups, int numPoints)
     JELLO_ASSERT(g.first + static_cast<int>(g.mask.size()) + g.delta <= n_,
                  "a spring group reaches past the last point");
     numSprings_ += g.numSprings;
+    maxDelta_ = std::max(maxDelta_, g.delta);
   }
 }
 
@@ -70,12 +72,13 @@ inline double springScale(double dx, double dy, double dz, double wx, double wy,
 
 // A group with delta >= kFusedMinDelta: one pass adds the force to both ends. Arrays are
 // component arrays offset to the group's first base point.
-void accumulateGroupFused(const SpringGroup& g, std::ptrdiff_t count, const double* __restrict x,
-                          const double* __restrict y, const double* __restrict z,
-                          const double* __restrict vx, const double* __restrict vy,
-                          const double* __restrict vz, double* fx, double* fy, double* fz) {
+void accumulateGroupFused(const SpringGroup& g, std::ptrdiff_t offset, std::ptrdiff_t count,
+                          const double* __restrict x, const double* __restrict y,
+                          const double* __restrict z, const double* __restrict vx,
+                          const double* __restrict vy, const double* __restrict vz, double* fx,
+                          double* fy, double* fz) {
   const double k = g.stiffness, c = g.damping, L0 = g.rest;
-  const double* __restrict mask = g.mask.data();
+  const double* __restrict mask = g.mask.data() + offset;
   const std::ptrdiff_t d = g.delta;
 #pragma omp simd safelen(kFusedMinDelta)
   for (std::ptrdiff_t s = 0; s < count; ++s) {
@@ -133,6 +136,34 @@ void subtractFromPartners(std::ptrdiff_t count, const double* __restrict gx,
 }  // namespace
 
 void SpringForces::accumulate(const double* x, const double* v, double* f) const {
+  const int threads = n_ >= kParallelMinPoints ? parallelThreads() : 1;
+  if (threads <= 1) {
+    accumulateRange(x, v, f, 0, n_);
+    return;
+  }
+  // Split the base points into `threads` runs separated by gaps of maxDelta_ points: a run's
+  // springs write only to its own points and the next maxDelta_ ones, which no other run
+  // touches, so the runs go in parallel; the gaps' springs follow, one after another. At 32^3
+  // the gaps are 6% of the points. The sums differ from the serial ones only in the order in
+  // which a few points receive their terms (round-off).
+  const std::ptrdiff_t n = n_, gap = maxDelta_;
+  const std::ptrdiff_t run = (n - gap * (threads - 1)) / threads;
+  if (run <= gap) {
+    accumulateRange(x, v, f, 0, n_);
+    return;
+  }
+  const auto runStart = [&](int t) { return t * (run + gap); };
+  runParallel(threads, [&](int t) {
+    const std::ptrdiff_t lo = runStart(t), hi = t + 1 == threads ? n : lo + run;
+    accumulateRange(x, v, f, lo, hi);
+  });
+  for (int t = 0; t + 1 < threads; ++t) {
+    accumulateRange(x, v, f, runStart(t) + run, runStart(t + 1));
+  }
+}
+
+void SpringForces::accumulateRange(const double* x, const double* v, double* f, std::ptrdiff_t lo,
+                                   std::ptrdiff_t hi) const {
   const int n = n_;
   // The base points' forces of a group with a short offset are kept for the partners' pass in
   // two chunk buffers on the stack (no state in the object, so threads may share it). The
@@ -144,10 +175,14 @@ void SpringForces::accumulate(const double* x, const double* v, double* f) const
   static_assert(kChunk >= kFusedMinDelta);
   alignas(64) double buffer[2][3][kChunk];
   for (const SpringGroup& g : groups_) {
-    const std::ptrdiff_t count = static_cast<std::ptrdiff_t>(g.mask.size());
-    const std::ptrdiff_t p = g.first, q = g.first + g.delta;
+    const std::ptrdiff_t size = static_cast<std::ptrdiff_t>(g.mask.size());
+    // This call's springs: base points in [lo, hi).
+    const std::ptrdiff_t begin = std::clamp<std::ptrdiff_t>(lo - g.first, 0, size);
+    const std::ptrdiff_t count = std::clamp<std::ptrdiff_t>(hi - g.first, 0, size) - begin;
+    if (count <= 0) continue;
+    const std::ptrdiff_t p = g.first + begin, q = p + g.delta;
     if (g.delta >= kFusedMinDelta) {
-      accumulateGroupFused(g, count, x + p, x + n + p, x + 2 * n + p, v + p, v + n + p,
+      accumulateGroupFused(g, begin, count, x + p, x + n + p, x + 2 * n + p, v + p, v + n + p,
                            v + 2 * n + p, f + p, f + n + p, f + 2 * n + p);
       continue;
     }
@@ -159,12 +194,13 @@ void SpringForces::accumulate(const double* x, const double* v, double* f) const
     int b = 0;
     for (std::ptrdiff_t s0 = 0; s0 < count; s0 += kChunk, b ^= 1) {
       const std::ptrdiff_t len = std::min(kChunk, count - s0), a = p + s0, c = q + s0;
-      accumulateGroup(g, s0, len, x + a, x + n + a, x + 2 * n + a, x + c, x + n + c, x + 2 * n + c,
-                      v + a, v + n + a, v + 2 * n + a, v + c, v + n + c, v + 2 * n + c, f + a,
-                      f + n + a, f + 2 * n + a, buffer[b][0], buffer[b][1], buffer[b][2]);
+      accumulateGroup(g, begin + s0, len, x + a, x + n + a, x + 2 * n + a, x + c, x + n + c,
+                      x + 2 * n + c, v + a, v + n + a, v + 2 * n + a, v + c, v + n + c,
+                      v + 2 * n + c, f + a, f + n + a, f + 2 * n + a, buffer[b][0], buffer[b][1],
+                      buffer[b][2]);
       if (s0 > 0) partners(s0 - kChunk, b ^ 1);
     }
-    if (count > 0) partners((count - 1) / kChunk * kChunk, b ^ 1);
+    partners((count - 1) / kChunk * kChunk, b ^ 1);
   }
 }
 

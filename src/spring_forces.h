@@ -8,6 +8,7 @@
 // compiler vectorizes the square root and division, the cost that bounds a step.
 #pragma once
 
+#include <cstddef>
 #include <vector>
 
 #include "src/jacobian_blocks.h"
@@ -43,7 +44,8 @@ class SpringForces {
   SpringForces(std::vector<SpringGroup> groups, int numPoints);
 
   // Adds the spring forces (N) of state (x, v) to f. All arrays component-major, 3n. Keeps no
-  // state: threads may evaluate one SpringForces at once.
+  // state: threads may evaluate one SpringForces at once. From kParallelMinPoints points up
+  // the work is split over parallelThreads() threads (src/parallel.h).
   void accumulate(const double* x, const double* v, double* f) const;
   double energy(const double* x) const;  // J
   // Adds the springs' blocks of K and D at positions x (the forces are linear in v, so D does
@@ -59,9 +61,14 @@ class SpringForces {
   std::vector<Spring> springs() const;
 
  private:
+  // The springs whose base point is in [lo, hi) (both ends' forces).
+  void accumulateRange(const double* x, const double* v, double* f, std::ptrdiff_t lo,
+                       std::ptrdiff_t hi) const;
+
   std::vector<SpringGroup> groups_;
   int n_;
   int numSprings_ = 0;
+  int maxDelta_ = 0;  // the largest offset of a spring's partner
 };
 
 }  // namespace jello

@@ -3,6 +3,7 @@
 // machine.
 //   BM_SpringForces/N    one evaluation of every spring; items/s = spring evaluations/s
 //   BM_Step/<integrator>/N  one full step on jello.w resampled to N^3; items/s = steps/s
+//   BM_Threads/...       the spring forces and an RK4 step on 1 and 2 threads (no taskset)
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
@@ -12,6 +13,7 @@
 
 #include "solvers/simulation.h"
 #include "solvers/solver_threads.h"
+#include "src/parallel.h"
 #include "src/scene_builder.h"
 #include "src/world_reader.h"
 
@@ -58,6 +60,39 @@ void BM_Step(benchmark::State& state, jello::IntegratorKind kind) {
 BENCHMARK_CAPTURE(BM_Step, rk4, jello::IntegratorKind::RK4)->Arg(8)->Arg(16)->Arg(32);
 BENCHMARK_CAPTURE(BM_Step, euler, jello::IntegratorKind::Euler)->Arg(8);
 BENCHMARK_CAPTURE(BM_Step, symplectic, jello::IntegratorKind::Symplectic)->Arg(8);
+
+// Both cores (src/parallel.h): the spring forces and a whole RK4 step at N^3 with the given
+// number of threads, 1 (serial) against 2, in one run. Run without taskset.
+void BM_Threads(benchmark::State& state, bool wholeStep) {
+  const int n = static_cast<int>(state.range(0));
+  const int threads = static_cast<int>(state.range(1));
+  jello::setParallelThreads(threads);
+  const jello::World world = jello::resampleCube(jelloWorld(), n);
+  jello::Simulation sim(world, jello::IntegratorKind::RK4);
+  const jello::State s = jello::initialState(world);
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(s.x.size());
+  for (auto _ : state) {
+    if (wholeStep) {
+      if (!sim.step().ok) state.SkipWithError("diverged");
+    } else {
+      sim.model().springs().accumulate(s.x.data(), s.v.data(), f.data());
+      benchmark::DoNotOptimize(f.data());
+      benchmark::ClobberMemory();
+    }
+  }
+  state.counters["threads"] = threads;
+  jello::setParallelThreads(1);
+}
+BENCHMARK_CAPTURE(BM_Threads, springs, false)
+    ->ArgNames({"N", "threads"})
+    ->ArgsProduct({{16, 32}, {1, 2}})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Threads, rk4_step, true)
+    ->ArgNames({"N", "threads"})
+    ->ArgsProduct({{16, 32}, {1, 2}})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 
 }  // namespace
 
