@@ -172,8 +172,9 @@ def context_line(r):
     c = r.context
     return (f"Measured {c['date'][:10]} with `scripts/speed-tables.py --run` (one core, "
             f"medians of 3 repetitions, {c.get('host_name', '?')}, {c['num_cpus']} CPUs at "
-            f"{c['mhz_per_cpu']} MHz, library build {c.get('library_build_type', '?')}; "
-            "`experiments/results/speed.json`).")
+            f"{c['mhz_per_cpu']} MHz, the Release build: `-O3 -march=native`; "
+            "`experiments/results/speed.json`). The machine is a shared VM: compare figures "
+            "within one run, not across runs.")
 
 
 def main():

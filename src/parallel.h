@@ -1,16 +1,19 @@
 // Both cores for the model's large loops (README "Speed"): a small pool of worker threads that
 // runs the parts of one loop at once. Only the spring forces use it, and only from
-// kParallelMinPoints points up, where a loop is long enough (about a millisecond) to pay for
-// waking a thread (microseconds). The pool is shared by the process: a caller that finds it busy
-// (another thread's loop, an experiment's parallel grid) runs its parts itself, one after another,
-// so the result never depends on who got the pool.
+// kParallelMinPoints points up, where a loop is long enough (milliseconds) to pay for waking a
+// thread and for the worker's spinning beside the step's serial rest. The pool is shared by the
+// process: a caller that finds it busy (another thread's loop, an experiment's parallel grid)
+// runs its parts itself, one after another.
 #pragma once
 
 #include <functional>
 
 namespace jello {
 
-inline constexpr int kParallelMinPoints = 16 * 16 * 16;
+// Measured (experiments/results/speed_threads.json): at 16^3 the spring forces ran 1.35x faster
+// on two threads but a whole RK4 step 0.87x slower (the waiting worker and the serial rest of the
+// step share the VM's two CPUs); at 32^3 1.86x and 1.42x.
+inline constexpr int kParallelMinPoints = 32 * 32 * 32;
 
 // The threads a loop is split over: setParallelThreads's value if called, else the environment's
 // JELLO_THREADS (1 = serial), else the CPUs this process may run on, at most 8.
