@@ -191,7 +191,9 @@ def cvode_table_from_json():
         if not b["name"].startswith("BM_CvodeOneSecond/"):
             continue
         variant = b["name"].split("/")[1].split("_", 1)[1]
-        label = {"cholmod": "BDF, CHOLMOD", "cg": "BDF, CG", "adams": "Adams, fixed point"}
+        label = {"cholmod": "BDF, CHOLMOD", "cg": "BDF, CG (jacobi, matrix-free)",
+                 "adams": "Adams, fixed point",
+                 "spgmr": "BDF, SPGMR preconditioned by a kept CHOLMOD factor"}
         lines.append(f"| {label.get(variant, variant)} | {duration(milliseconds(b))} | "
                      f"{b['cvode_steps']:.0f} | {b['error_test_failures']:.0f} | "
                      f"{b.get('factorizations', 0):.0f} |")

@@ -2,6 +2,7 @@
 
 #include <cvode/cvode_ls.h>
 #include <nvector/nvector_serial.h>
+#include <sunlinsol/sunlinsol_spgmr.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
 #include <cmath>
@@ -40,6 +41,28 @@ int linsysTrampoline(sunrealtype, N_Vector y, N_Vector, SUNMatrix, sunbooleantyp
   const int rc = self(data).linearSystem(N_VGetArrayPointer(y), jok != SUNFALSE, &current, gamma);
   *jcur = current ? SUNTRUE : SUNFALSE;
   return rc;
+}
+
+// SPGMR's preconditioner: when CVODE allows it (jok), the factor of the last setup is kept as it
+// is, its gamma included (a preconditioner only needs to be near); otherwise the Jacobian is
+// assembled at y and the reduced matrix formed and factored afresh.
+int psetupTrampoline(sunrealtype, N_Vector y, N_Vector, sunbooleantype jok, sunbooleantype* jcur,
+                     sunrealtype gamma, void* data) {
+  CvodeIntegrator& integrator = self(data);
+  if (jok != SUNFALSE && integrator.preconditionerReady()) {
+    *jcur = SUNFALSE;
+    return 0;
+  }
+  bool current = false;
+  int rc = integrator.linearSystem(N_VGetArrayPointer(y), false, &current, gamma);
+  *jcur = SUNTRUE;
+  if (rc == 0) rc = integrator.setupSolver();
+  integrator.setPreconditionerReady(rc == 0);
+  return rc;
+}
+int psolveTrampoline(sunrealtype, N_Vector, N_Vector, N_Vector r, N_Vector z, sunrealtype,
+                     sunrealtype, int, void* data) {
+  return self(data).solve(N_VGetArrayPointer(r), N_VGetArrayPointer(z));
 }
 
 // The custom linear solver: its content is the integrator, which SUNDIALS must never free.
@@ -133,6 +156,7 @@ StepResult CvodeIntegrator::start(const Model& model, const State& s) {
   lastV_ = s.v;
   t_ = s.t;
   assembled_ = false;
+  preconditionerReady_ = false;
   restartPending_ = false;
   ++restarts_;
 
@@ -184,6 +208,17 @@ StepResult CvodeIntegrator::start(const Model& model, const State& s) {
     return check("CVodeSetNonlinearSolver", CVodeSetNonlinearSolver(mem, nonlinearSolver_.get()));
   }
 
+  if (usesKrylov()) {
+    linearSolver_.reset(SUNLinSol_SPGMR(y_.get(), SUN_PREC_LEFT, 0, context_.get()));
+    if (!linearSolver_) return StepResult::failure("SUNLinSol_SPGMR failed");
+    if (StepResult r =
+            check("CVodeSetLinearSolver", CVodeSetLinearSolver(mem, linearSolver_.get(), nullptr));
+        !r.ok) {
+      return r;
+    }
+    return check("CVodeSetPreconditioner",
+                 CVodeSetPreconditioner(mem, psetupTrampoline, psolveTrampoline));
+  }
   SUNMatrix A = SUNMatNewEmpty(context_.get());
   if (!A) return StepResult::failure("SUNMatNewEmpty failed");
   A->ops->getid = matId;
@@ -325,7 +360,13 @@ constexpr Counter kCounters[] = {
     {"newton_iterations", CVodeGetNumNonlinSolvIters},
     {"newton_convergence_failures", CVodeGetNumNonlinSolvConvFails},
     {"error_test_failures", CVodeGetNumErrTestFails},
+    // Krylov (SPGMR) only; zero otherwise, and left out.
+    {"linear_iterations", CVodeGetNumLinIters},
+    {"preconditioner_setups", CVodeGetNumPrecEvals},
+    {"preconditioner_solves", CVodeGetNumPrecSolves},
+    {"jtimes_rhs_evaluations", CVodeGetNumLinRhsEvals},
 };
+constexpr std::size_t kFirstKrylovCounter = 6;
 static_assert(std::size(kCounters) == CvodeIntegrator::kNumCounters);
 
 }  // namespace
@@ -333,6 +374,7 @@ static_assert(std::size(kCounters) == CvodeIntegrator::kNumCounters);
 void CvodeIntegrator::carryCounters() {
   if (!cvode_) return;
   for (std::size_t i = 0; i < kNumCounters; ++i) {
+    if (i >= kFirstKrylovCounter && !usesKrylov()) continue;  // no linear-solver interface
     long value = 0;
     if (kCounters[i].getter(cvode_.get(), &value) == CV_SUCCESS) carried_[i] += value;
   }
@@ -345,6 +387,7 @@ std::vector<Statistic> CvodeIntegrator::statistics() const {
   // Each getter's flag is checked; a figure whose getter fails is left out. The counts of
   // earlier starts (restarts, contact roots) are added.
   for (std::size_t i = 0; i < kNumCounters; ++i) {
+    if (i >= kFirstKrylovCounter && !usesKrylov()) continue;
     long value = 0;
     if (kCounters[i].getter(mem, &value) == CV_SUCCESS) {
       stats.push_back({kCounters[i].name, static_cast<double>(value + carried_[i])});

@@ -41,13 +41,17 @@ class CvodeIntegrator final : public Integrator {
   // The callbacks' work (public for the C trampolines in the .cpp).
   int rightHandSide(const double* y, double* ydot);
   int linearSystem(const double* y, bool jacobianOk, bool* jacobianCurrent, double gamma);
+  // BDF with SPGMR (CvodeOptions::krylov): Adams has no linear solver.
+  bool usesKrylov() const { return options_.krylov && options_.method == CvodeMethod::Bdf; }
+  bool preconditionerReady() const { return preconditionerReady_; }
+  void setPreconditionerReady(bool ready) { preconditionerReady_ = ready; }
   int setupSolver();
   int solve(const double* b, double* x);
   int contactDepths(const double* y, double* g);
   void noteSundialsMessage(std::string message) { sundialsMessage_ = std::move(message); }
   int numRootFunctions() const;
 
-  static constexpr std::size_t kNumCounters = 6;
+  static constexpr std::size_t kNumCounters = 10;
 
  private:
   StepResult start(const Model& model, const State& state);
@@ -75,6 +79,7 @@ class CvodeIntegrator final : public Integrator {
   Eigen::VectorXd lastX_, lastV_;  // the state last handed out, to notice changes from outside
   double t_ = 0.0;                 // CVODE's time, to notice a state changed from outside
   long restarts_ = 0, roots_ = 0;
+  bool preconditionerReady_ = false;  // krylov: a factor from an earlier setup is there
   std::array<long, kNumCounters> carried_{};
   std::string sundialsMessage_;  // SUNDIALS' last error message, for ours
   bool restartPending_ = false;  // the model's forces changed from outside

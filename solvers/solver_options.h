@@ -55,6 +55,11 @@ struct CvodeOptions {
   LinearSolverKind linearSolver = LinearSolverKind::Cholmod;
   PreconditionerKind preconditioner = PreconditionerKind::Jacobi;
   bool matrixFree = true;
+  // bdf: Newton's systems by SUNDIALS' SPGMR (matrix-free: CVODE's difference-quotient J v,
+  // its tolerance set by CVODE), preconditioned by the reduced system solved with linearSolver,
+  // whose factor is kept between CVODE's preconditioner setups (Jacobian reuse). Off: the
+  // reduced system solved exactly as a custom DIRECT solver.
+  bool krylov = false;
   bool clampCompression = true;
   double cgTolerance = 1e-6;
 

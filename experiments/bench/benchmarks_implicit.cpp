@@ -205,11 +205,12 @@ bool runOneSecond(Simulation& sim) {
 }
 
 void BM_CvodeOneSecond(benchmark::State& st, double rtol, LinearSolverKind kind,
-                       CvodeMethod method = CvodeMethod::Bdf) {
+                       CvodeMethod method = CvodeMethod::Bdf, bool krylov = false) {
   SolverOptions options;
   options.cvode.rtol = rtol;
   options.cvode.linearSolver = kind;
   options.cvode.method = method;
+  options.cvode.krylov = krylov;
   for (auto _ : st) {
     Simulation sim(jelloAt(8), IntegratorKind::Cvode, 0.01, options);
     if (!runOneSecond(sim)) st.SkipWithError("cvode failed");
@@ -224,6 +225,10 @@ BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e3_cg, 1e-3, LinearSolverKind::Cg)
     ->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e3_adams, 1e-3, LinearSolverKind::Cholmod,
                   CvodeMethod::Adams)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e3_spgmr, 1e-3, LinearSolverKind::Cholmod,
+                  CvodeMethod::Bdf, true)
     ->Iterations(1)
     ->Unit(benchmark::kSecond);
 BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e6_cholmod, 1e-6, LinearSolverKind::Cholmod)

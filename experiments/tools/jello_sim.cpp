@@ -406,6 +406,10 @@ int main(int argc, char** argv) {
   app.add_option("--atol-v", cvode.atolVelocity, "cvode: absolute tolerance of velocities (m/s)")
       ->check(jello::cli::positive())
       ->group(implicitGroup);
+  app.add_flag("--cvode-krylov", cvode.krylov,
+               "cvode (bdf): solve Newton's systems by SPGMR, matrix-free, preconditioned by "
+               "the reduced system (--linear-solver), its factor kept between setups")
+      ->group(implicitGroup);
   app.add_flag("--contact-roots", cvode.contactRoots,
                "cvode: locate contact onset and release as roots and restart there")
       ->group(implicitGroup);

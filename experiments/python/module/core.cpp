@@ -200,8 +200,8 @@ void translateExceptions(std::exception_ptr p) {
 constexpr const char* kSolverOptionNames =
     "linear_solver, preconditioner, matrix_free, clamp, cg_tol, newton_iters, newton_tol, "
     "newton_xtol, factor_reuse, "
-    "refactor_ratio, projective_iters, projective_tol, rtol, cvode_method, atol, atol_x, atol_v, "
-    "contact_roots, max_order, stab_lim_det, max_step";
+    "refactor_ratio, projective_iters, projective_tol, rtol, cvode_method, cvode_krylov, atol, "
+    "atol_x, atol_v, contact_roots, max_order, stab_lim_det, max_step";
 
 bool boolOption(const py::handle& v, const std::string& name) {
   if (!py::isinstance<py::bool_>(v)) valueError(name + " must be True or False");
@@ -256,6 +256,8 @@ jello::SolverOptions solverOptionsFrom(const py::kwargs& kwargs, jello::SolverOp
       o.cvode.atolPosition = positive(real(), n);
     } else if (name == "atol_v") {
       o.cvode.atolVelocity = positive(real(), n);
+    } else if (name == "cvode_krylov") {
+      o.cvode.krylov = boolOption(value, name);
     } else if (name == "contact_roots") {
       o.cvode.contactRoots = boolOption(value, name);
     } else if (name == "max_order") {
