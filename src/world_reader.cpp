@@ -107,7 +107,7 @@ class Tokenizer {
 };
 
 bool isExtensionKeyword(std::string_view s) {
-  return s == "cube" || s == "sphere";
+  return s == "integrator" || s == "cube" || s == "sphere";
 }
 
 bool looksNumeric(std::string_view s) {
@@ -128,8 +128,23 @@ bool completeCube(std::size_t count) {
 void readExtensions(Tokenizer& in, Token keyword, World& world, const ReaderLimits& limits) {
   bool seenCube = false;
   bool seenSphere = false;
+  bool seenIntegrator = false;
   while (!keyword.text.empty()) {
-    if (keyword.text == "cube") {
+    if (keyword.text == "integrator") {
+      if (seenIntegrator) in.fail(keyword, "extension 'integrator' given twice");
+      seenIntegrator = true;
+      const Token name = in.next();
+      if (name.text.empty()) in.fail(name, "file ends where an integrator name was expected");
+      if (const auto kind = parseIntegratorName(name.text)) {
+        world.integrator = *kind;
+        world.unknownIntegrator.clear();
+      } else if (limits.acceptUnknownIntegrator) {
+        world.unknownIntegrator = std::string(name.text);  // the caller overrides it
+      } else {
+        in.fail(name, "unknown integrator (known: " + integratorNameList() +
+                          "; --integrator on the command line overrides it)");
+      }
+    } else if (keyword.text == "cube") {
       if (seenCube) in.fail(keyword, "extension 'cube' given twice");
       seenCube = true;
       const int n = in.integer("cube resolution");
@@ -148,7 +163,7 @@ void readExtensions(Tokenizer& in, Token keyword, World& world, const ReaderLimi
       s.radius = in.positive("sphere radius");
       world.sphere = s;
     } else {
-      in.fail(keyword, "unknown trailing content (extension keywords: cube, sphere)");
+      in.fail(keyword, "unknown trailing content (extension keywords: integrator, cube, sphere)");
     }
     keyword = in.next();
   }

@@ -47,9 +47,16 @@ class Printer {
 
 }  // namespace
 
+// The original loader reads line 1 into a 10-byte buffer and knows only these two names.
+bool originalIntegrator(IntegratorKind kind) {
+  return kind == IntegratorKind::Euler || kind == IntegratorKind::RK4;
+}
+
 std::string formatWorld(const World& w, NumberFormat format) {
   Printer p(format);
-  p.text(integratorFileName(w.integrator));
+  // Line 1 always holds a name the original loader knows; another integrator goes into the
+  // extension block, which that loader never reads.
+  p.text(integratorFileName(originalIntegrator(w.integrator) ? w.integrator : IntegratorKind::RK4));
   p.numberInt(w.dt, w.stepsPerFrame);
   p.numbers({w.kElastic, w.dElastic, w.kCollision, w.dCollision});
   p.numbers({w.mass});
@@ -60,6 +67,9 @@ std::string formatWorld(const World& w, NumberFormat format) {
   for (const Vec3& x : w.positions) p.vec(x);
   for (const Vec3& v : w.velocities) p.vec(v);
   // The extension block: after the velocities, where the original loader stops reading.
+  if (!originalIntegrator(w.integrator)) {
+    p.text("integrator " + std::string(integratorFileName(w.integrator)));
+  }
   if (w.cubeResolution != kDefaultCubeResolution) p.textInt("cube ", w.cubeResolution);
   if (w.sphere) {
     std::string line = "sphere ";

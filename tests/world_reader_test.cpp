@@ -216,7 +216,13 @@ INSTANTIATE_TEST_SUITE_P(
                  "unknown trailing content"},
         BadInput{"NegativeSphereRadius", 0, "", 0, "sphere 0 0 0 -1\n", 1040, "-1",
                  "must be positive"},
-        BadInput{"CubeTwice", 0, "", 0, "cube 8\ncube 8\n", 1041, "cube", "given twice"}),
+        BadInput{"CubeTwice", 0, "", 0, "cube 8\ncube 8\n", 1041, "cube", "given twice"},
+        BadInput{"IntegratorTwice", 0, "", 0, "integrator implicit\nintegrator bdf2\n", 1041,
+                 "integrator", "given twice"},
+        BadInput{"UnknownIntegratorExtension", 0, "", 0, "integrator Verlet\n", 1040, "Verlet",
+                 "unknown integrator"},
+        BadInput{"IntegratorExtensionWithoutName", 0, "", 0, "integrator\n", 1041, "<end of file>",
+                 "integrator name was expected"}),
     [](const auto& param_info) { return param_info.param.name; });
 
 TEST(WorldReader, RefusesAHugeCubeBeforeAllocating) {

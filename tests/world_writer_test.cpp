@@ -82,6 +82,34 @@ TEST(WorldWriter, WritesNoExtensionBlockForAnOriginalScene) {
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 7 + 27000 + 1024);
 }
 
+// The original course loader reads line 1 into a 10-byte buffer and knows Euler and RK4: every
+// written file keeps line 1 to one of them, and any other integrator travels in the extension
+// block, which that loader never reads (#16 item 11).
+TEST(WorldWriter, LineOneAlwaysHoldsANameTheOriginalLoaderKnows) {
+  for (IntegratorKind kind : allIntegrators()) {
+    World w = test::loadWorld("jello.w");
+    w.integrator = kind;
+    for (NumberFormat format : {NumberFormat::Exact, NumberFormat::Legacy}) {
+      const std::string text = formatWorld(w, format);
+      const std::string first = text.substr(0, text.find('\n'));
+      EXPECT_TRUE(first == "RK4" || first == "Euler") << first;
+      EXPECT_LT(first.size(), 10u);
+      const bool original = kind == IntegratorKind::Euler || kind == IntegratorKind::RK4;
+      EXPECT_EQ(text.find("\nintegrator ") != std::string::npos, !original) << integratorName(kind);
+      EXPECT_EQ(parseWorld(text, "w").integrator, kind) << integratorName(kind);
+    }
+  }
+  // A file of the earlier layout, the integrator on line 1, still reads; the extension wins
+  // over line 1 where both are given.
+  World w = test::loadWorld("jello.w");
+  std::string text = formatWorld(w);
+  EXPECT_EQ(parseWorld("bdf2" + text.substr(3), "old").integrator, IntegratorKind::Bdf2);
+  EXPECT_EQ(parseWorld(text + "integrator midpoint\n", "new").integrator, IntegratorKind::Midpoint);
+  ReaderLimits lenient;
+  lenient.acceptUnknownIntegrator = true;
+  EXPECT_EQ(parseWorld(text + "integrator IPC\n", "ipc", lenient).unknownIntegrator, "IPC");
+}
+
 TEST(WorldWriter, ExtensionsRoundTrip) {
   SceneSpec spec;
   spec.cubeResolution = 5;
