@@ -28,7 +28,8 @@ class Tokenizer {
     skipSpace();
     const std::size_t start = pos_;
     while (pos_ < text_.size() && !isSpace(text_[pos_])) ++pos_;
-    return {text_.substr(start, pos_ - start), line_};
+    lastToken_ = {text_.substr(start, pos_ - start), line_};
+    return lastToken_;
   }
 
   std::size_t remainingBytes() const { return text_.size() - pos_; }
@@ -57,7 +58,8 @@ class Tokenizer {
     return value;
   }
 
-  int integer(const char* what) {
+  // `hint` is added to the message when the token is not an integer.
+  int integer(const char* what, const std::string& hint = {}) {
     const Token t = next();
     if (t.text.empty()) fail(t, std::string("file ends where ") + what + " was expected");
     int value = 0;
@@ -66,9 +68,8 @@ class Tokenizer {
     const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
     if (ec == std::errc::result_out_of_range) fail(t, std::string(what) + " is out of range");
     if (ec != std::errc() || end != s.data() + s.size()) {
-      fail(t, std::string("expected an integer for ") + what);
+      fail(t, std::string("expected an integer for ") + what + hint);
     }
-    lastToken_ = t;
     return value;
   }
 
@@ -171,15 +172,39 @@ void readExtensions(Tokenizer& in, Token keyword, World& world, const ReaderLimi
 
 }  // namespace
 
+// A token as a message shows it: at most kShownTokenBytes bytes (a 50 MB "number" is not
+// repeated), control and non-ASCII bytes as \xNN (no terminal escape codes pass through).
+std::string displayToken(std::string_view token) {
+  constexpr std::size_t kShownTokenBytes = 40;
+  std::string out;
+  for (std::size_t i = 0; i < token.size() && i < kShownTokenBytes; ++i) {
+    const auto c = static_cast<unsigned char>(token[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      out += static_cast<char>(c);
+    } else {
+      static constexpr char hex[] = "0123456789abcdef";
+      out += "\\x";
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    }
+  }
+  if (token.size() > kShownTokenBytes) {
+    out += "... (" + std::to_string(token.size()) + " bytes)";
+  }
+  return out;
+}
+
 WorldFileError::WorldFileError(std::string file, int line, std::string token,
                                const std::string& message)
-    : std::runtime_error(file + ":" + std::to_string(line) + ": " + message + " (at '" + token +
-                         "')"),
+    : std::runtime_error(displayToken(file) + ":" + std::to_string(line) + ": " + message +
+                         " (at '" + displayToken(token) + "')"),
       file_(std::move(file)),
       line_(line),
-      token_(std::move(token)) {}
+      token_(displayToken(token)) {}
 
 World parseWorld(std::string_view text, const std::string& name, const ReaderLimits& limits) {
+  // A UTF-8 byte-order mark (some editors write one) is not part of the first token.
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
   Tokenizer in(text, name);
   World w;
 
@@ -202,9 +227,18 @@ World parseWorld(std::string_view text, const std::string& name, const ReaderLim
   w.dElastic = in.nonNegative("dElastic");
   w.kCollision = in.nonNegative("kCollision");
   w.dCollision = in.nonNegative("dCollision");
+  const int constantsLine = in.lastToken().line;
   w.mass = in.positive("the point mass");
+  // Line breaks carry no meaning, but a mass on the constants' line usually means that line has
+  // too many numbers, which is what to say when the plane flag then fails.
+  const std::string flagHint =
+      in.lastToken().line == constantsLine
+          ? " (line " + std::to_string(constantsLine) +
+                " holds more numbers than the four constants kElastic dElastic kCollision "
+                "dCollision: the extra ones were read as the mass and the plane flag)"
+          : std::string();
 
-  if (in.integer("the plane flag") == 1) {
+  if (in.integer("the plane flag", flagHint) == 1) {
     const Token first = in.next();
     Plane p;
     p.a = in.toNumber(first, "plane a");

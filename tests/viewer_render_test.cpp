@@ -224,6 +224,8 @@ TEST(ViewerCommandLine, ABadWorldNamesFileLineAndToken) {
 TEST(ViewerCommandLine, BadOptionsAreRefused) {
   EXPECT_EQ(run(jello() + " --frames 301 --record /tmp/x").code, 2);
   EXPECT_EQ(run(jello() + " --frames 10").code, 2);  // --frames needs --record
+  // An empty directory would open the interactive window and hang a script.
+  EXPECT_EQ(run(jello() + " --record '' --frames 3").code, 2);
   EXPECT_EQ(run(jello() + " --size 640by480").code, 2);
   EXPECT_EQ(run(jello() + " --integrator leapfrog").code, 2);
   const Outcome help = run(jello() + " --help");

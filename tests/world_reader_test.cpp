@@ -217,6 +217,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"NegativeSphereRadius", 0, "", 0, "sphere 0 0 0 -1\n", 1040, "-1",
                  "must be positive"},
         BadInput{"CubeTwice", 0, "", 0, "cube 8\ncube 8\n", 1041, "cube", "given twice"},
+        BadInput{"SixConstants", 3, "200 0.25 400 0.25 0.25 0.25", 0, "", 3, "0.25",
+                 "holds more numbers than the four constants"},
         BadInput{"IntegratorTwice", 0, "", 0, "integrator implicit\nintegrator bdf2\n", 1041,
                  "integrator", "given twice"},
         BadInput{"UnknownIntegratorExtension", 0, "", 0, "integrator Verlet\n", 1040, "Verlet",
@@ -241,6 +243,38 @@ TEST(WorldReader, ReportsAMissingFile) {
     EXPECT_EQ(e.line(), 0);
     EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/world.w"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("cannot open"), std::string::npos);
+  }
+}
+
+// Some editors start a file with a UTF-8 byte-order mark: it is not part of the integrator.
+TEST(WorldReader, AcceptsAByteOrderMark) {
+  const std::string text = join(validLines());
+  const World plain = parseWorld(text, "plain.w");
+  const World marked = parseWorld("\xEF\xBB\xBF" + text, "bom.w");
+  EXPECT_EQ(marked.integrator, plain.integrator);
+  EXPECT_EQ(marked.positions.size(), plain.positions.size());
+}
+
+// A bad token is shown at most 40 bytes long, control and non-ASCII bytes escaped: a 1 MB
+// "number" or a terminal escape sequence never reaches the message whole.
+TEST(WorldReader, ShowsBadTokensShortAndEscaped) {
+  std::vector<std::string> lines = validLines();
+  lines[1] = std::string(1 << 20, '7') + "x 1";
+  try {
+    (void)parseWorld(join(lines), "long.w");
+    FAIL() << "accepted";
+  } catch (const WorldFileError& e) {
+    EXPECT_LT(std::string(e.what()).size(), 300u);
+    EXPECT_NE(std::string(e.what()).find("(1048577 bytes)"), std::string::npos) << e.what();
+  }
+  lines = validLines();
+  lines[1] = "\x1b[31mred 1";
+  try {
+    (void)parseWorld(join(lines), "escape.w");
+    FAIL() << "accepted";
+  } catch (const WorldFileError& e) {
+    EXPECT_EQ(std::string(e.what()).find('\x1b'), std::string::npos) << e.what();
+    EXPECT_EQ(e.token(), "\\x1b[31mred");
   }
 }
 

@@ -41,7 +41,13 @@ int main(int argc, char** argv) {
   app.add_option("--dt", opt.source.dt, "Time step (s), overriding the file's")
       ->check(jello::cli::positive());
   auto* record = app.add_option("--record", opt.recordDir,
-                                "Write frames 000.jpg, 001.jpg, ... into this directory and exit");
+                                "Write frames 000.jpg, 001.jpg, ... into this directory and exit")
+                     ->check(CLI::Validator(
+                         [](const std::string& dir) {
+                           return dir.empty() ? std::string("the recording directory is empty")
+                                              : std::string();
+                         },
+                         "DIR", "non-empty"));
   app.add_option("--frames", opt.frames, "Number of frames to record (1-300: 15 per second)")
       ->check(jello::cli::range(1, jello::viewer::kMaxRecordedFrames))
       ->needs(record);
