@@ -172,14 +172,16 @@ void readExtensions(Tokenizer& in, Token keyword, World& world, const ReaderLimi
 
 }  // namespace
 
-// A token as a message shows it: at most kShownTokenBytes bytes (a 50 MB "number" is not
-// repeated), control and non-ASCII bytes as \xNN (no terminal escape codes pass through).
-std::string displayToken(std::string_view token) {
-  constexpr std::size_t kShownTokenBytes = 40;
+// A token as a message shows it: at most `limit` bytes (a 50 MB "number" is not repeated),
+// control and non-ASCII bytes as \xNN (no terminal escape codes pass through). File names keep
+// their length and their UTF-8; only control bytes are escaped.
+constexpr std::size_t kShownTokenBytes = 40;
+std::string displayToken(std::string_view token, std::size_t limit = kShownTokenBytes,
+                         bool keepUtf8 = false) {
   std::string out;
-  for (std::size_t i = 0; i < token.size() && i < kShownTokenBytes; ++i) {
+  for (std::size_t i = 0; i < token.size() && i < limit; ++i) {
     const auto c = static_cast<unsigned char>(token[i]);
-    if (c >= 0x20 && c < 0x7f) {
+    if ((c >= 0x20 && c < 0x7f) || (keepUtf8 && c >= 0x80)) {
       out += static_cast<char>(c);
     } else {
       static constexpr char hex[] = "0123456789abcdef";
@@ -188,7 +190,7 @@ std::string displayToken(std::string_view token) {
       out += hex[c & 15];
     }
   }
-  if (token.size() > kShownTokenBytes) {
+  if (token.size() > limit) {
     out += "... (" + std::to_string(token.size()) + " bytes)";
   }
   return out;
@@ -196,7 +198,7 @@ std::string displayToken(std::string_view token) {
 
 WorldFileError::WorldFileError(std::string file, int line, std::string token,
                                const std::string& message)
-    : std::runtime_error(displayToken(file) + ":" + std::to_string(line) + ": " + message +
+    : std::runtime_error(displayToken(file, file.size(), true) + ":" + std::to_string(line) + ": " + message +
                          " (at '" + displayToken(token) + "')"),
       file_(std::move(file)),
       line_(line),
