@@ -198,8 +198,8 @@ std::string displayToken(std::string_view token, std::size_t limit = kShownToken
 
 WorldFileError::WorldFileError(std::string file, int line, std::string token,
                                const std::string& message)
-    : std::runtime_error(displayToken(file, file.size(), true) + ":" + std::to_string(line) + ": " + message +
-                         " (at '" + displayToken(token) + "')"),
+    : std::runtime_error(displayToken(file, file.size(), true) + ":" + std::to_string(line) + ": " +
+                         message + " (at '" + displayToken(token) + "')"),
       file_(std::move(file)),
       line_(line),
       token_(displayToken(token)) {}
