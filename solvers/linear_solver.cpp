@@ -33,7 +33,7 @@ struct SpdSolver::Impl {
   std::array<Eigen::VectorXd, 6> blockInverse;  // block-jacobi: per point, upper triangle
   bool staleFactor = false;                     // factor: llt holds an earlier A's factor
   bool icholAnalyzed = false;
-  int lastIterations = 0;
+  long lastIterations = 0;
   Eigen::VectorXd r, z, p, q;
   bool ldltAnalyzed = false;
   bool useLdlt = false;             // this factorization went to LDLT
@@ -266,7 +266,7 @@ StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::Vector
       product(s.p, s.q);
       const double pq = s.p.dot(s.q);
       if (!(pq > 0.0)) {
-        s.lastIterations = int(std::min<long>(it, 1 << 30));
+        s.lastIterations = it;
         return StepResult::failure(
             "CG: the matrix is not positive definite (p.Ap = " + std::to_string(pq) + ")");
       }
@@ -283,7 +283,7 @@ StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::Vector
     }
   }
   stats_.cgIterations += it;
-  s.lastIterations = int(std::min<long>(it, 1 << 30));
+  s.lastIterations = it;
   if (!(residual <= tolerance)) {
     std::ostringstream os;
     os << "CG did not converge in " << it << " iterations (relative residual " << residual / bNorm

@@ -1,5 +1,7 @@
 #include "solvers/system_operator.h"
 
+#include <algorithm>
+
 #include "src/assertions.h"
 
 namespace jello {
@@ -9,8 +11,8 @@ namespace {
 // Row-major indices of the upper triangle of a symmetric 3x3 block: xx, xy, xz, yy, yz, zz.
 constexpr int kUpper[6] = {0, 1, 2, 4, 5, 8};
 
-// y_base[s] += C[s] p_partner[s] over a group's springs, both ends as separate loops so each is
-// unit stride and writes one array set (no dependence between iterations).
+// y[s] += C[s] p[s] over a run of symmetric blocks (a group's springs, seen from one end, or the
+// points' diagonal blocks): unit stride, no dependence between iterations.
 void addBlockProducts(std::ptrdiff_t count, const std::array<std::vector<double>, 6>& c,
                       const double* __restrict px, const double* __restrict py,
                       const double* __restrict pz, double* __restrict yx, double* __restrict yy,
@@ -65,24 +67,11 @@ void SystemOperator::gather(const SparseMatrix& A, const std::vector<int>& diagS
 
 void SystemOperator::apply(const double* p, double* y) const {
   const std::ptrdiff_t n = n_;
-  const double* __restrict px = p;
-  const double* __restrict py = p + n;
-  const double* __restrict pz = p + 2 * n;
-  double* __restrict yx = y;
-  double* __restrict yy = y + n;
-  double* __restrict yz = y + 2 * n;
-  const double* __restrict gxx = diag_[0].data();
-  const double* __restrict gxy = diag_[1].data();
-  const double* __restrict gxz = diag_[2].data();
-  const double* __restrict gyy = diag_[3].data();
-  const double* __restrict gyz = diag_[4].data();
-  const double* __restrict gzz = diag_[5].data();
-#pragma omp simd
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
-    yx[i] = gxx[i] * px[i] + gxy[i] * py[i] + gxz[i] * pz[i];
-    yy[i] = gxy[i] * px[i] + gyy[i] * py[i] + gyz[i] * pz[i];
-    yz[i] = gxz[i] * px[i] + gyz[i] * py[i] + gzz[i] * pz[i];
-  }
+  const double *px = p, *py = p + n, *pz = p + 2 * n;
+  double *yx = y, *yy = y + n, *yz = y + 2 * n;
+  // The points' own blocks first (y = G p), then every spring's, both ends.
+  std::fill(y, y + 3 * n, 0.0);
+  addBlockProducts(n, diag_, px, py, pz, yx, yy, yz);
   for (const Group& g : groups_) {
     const std::ptrdiff_t a = g.first, b = g.first + g.delta;
     // Base points take their partners' values, then partners take the base points'.
