@@ -187,7 +187,7 @@ TEST(MouseForces, APullFallsOffLinearlyWithRestDistanceOverItsRadius) {
   const State s = restCube(8);
   const int picked = lattice.index(7, 3, 3);
   const Vec3 target = s.position(picked) + Vec3{0.5, 0.0, 0.0};
-  const double k = 10.0;
+  const PullSpring k{10.0, 0.0};  // undamped, unbounded
   const Eigen::VectorXd one = pullForce(lattice, s, picked, target, 0.0, k);
   EXPECT_NEAR(State::at(one, picked).x, 5.0, 1e-12);
   EXPECT_NEAR(one.norm(), 5.0, 1e-12);  // nothing else pulled
@@ -200,6 +200,31 @@ TEST(MouseForces, APullFallsOffLinearlyWithRestDistanceOverItsRadius) {
   const Eigen::VectorXd all = pullForce(lattice, s, picked, target, pullRadii().back(), k);
   EXPECT_NEAR(State::at(all, lattice.index(0, 0, 0)).x, 5.0, 1e-12);
   EXPECT_NEAR(all.head(lattice.numPoints()).sum(), 5.0 * lattice.numPoints(), 1e-9);
+}
+
+TEST(MouseForces, APullIsBoundedAndDampedSoNoDragFlingsTheCube) {
+  const Lattice lattice{8};
+  State s = restCube(8);
+  const int n = lattice.numPoints(), picked = lattice.index(7, 3, 3);
+  const double mass = 0.002;
+  const PullSpring spring = pullSpring(n, mass, 1000.0);
+  EXPECT_DOUBLE_EQ(spring.maxForce, kMaxPullAcceleration * mass * n);
+  EXPECT_DOUBLE_EQ(spring.damping, 2.0 * std::sqrt(1000.0 * mass));  // critical, per point
+  // A target 10 m away (a drag off the window's edge): the spring part is capped, whatever R.
+  for (double radius : pullRadii()) {
+    const Eigen::VectorXd f =
+        pullForce(lattice, s, picked, s.position(picked) + Vec3{10.0, 0.0, 0.0}, radius, spring);
+    double total = 0.0;
+    for (int p = 0; p < n; ++p) total += norm(State::at(f, p));
+    EXPECT_LE(total, spring.maxForce * (1 + 1e-12)) << "radius " << radius;
+    EXPECT_GT(total, 0.99 * spring.maxForce) << "radius " << radius;  // the bound, not less
+  }
+  // Points moving on their own are slowed: the pull's power on a moving cube at the target is
+  // negative (it takes energy out), exactly -c sum w v^2.
+  for (int p = 0; p < n; ++p) State::set(s.v, p, Vec3{0.3, -0.2, 0.1});
+  const Eigen::VectorXd f = pullForce(lattice, s, picked, s.position(picked), 0.3, spring);
+  EXPECT_LT(f.dot(s.v), 0.0);
+  EXPECT_NEAR(State::at(f, picked).x, -spring.damping * 0.3, 1e-12);
 }
 
 TEST(Picking, AScreenPointPicksTheVisibleSurfacePointDrawnThere) {

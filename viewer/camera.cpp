@@ -17,12 +17,12 @@ double tanHalfFov(const Camera& c) {
 }  // namespace
 
 Vec3 Camera::eye() const {
-  return {radius * std::cos(phi) * std::cos(theta), radius * std::sin(phi) * std::cos(theta),
-          radius * std::sin(theta)};
+  return center + Vec3{radius * std::cos(phi) * std::cos(theta),
+                       radius * std::sin(phi) * std::cos(theta), radius * std::sin(theta)};
 }
 
 Vec3 Camera::forward() const {
-  return normalized(Vec3{} - eye());
+  return normalized(center - eye());
 }
 
 Vec3 Camera::right() const {
@@ -42,6 +42,15 @@ void Camera::rotate(double dxPixels, double dyPixels) {
 
 void Camera::zoom(double metres) {
   radius = std::max(0.5, radius + metres);
+}
+
+void Camera::zoomBy(double factor) {
+  radius = std::clamp(radius * factor, 0.5, 100.0);
+}
+
+void Camera::pan(double dxPixels, double dyPixels, int viewportHeight) {
+  const double metresPerPixel = 2.0 * radius * tanHalfFov(*this) / std::max(viewportHeight, 1);
+  center = center - (right() * dxPixels - up() * dyPixels) * metresPerPixel;
 }
 
 Eigen::Matrix4d viewMatrix(const Camera& c) {

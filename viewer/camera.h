@@ -1,8 +1,9 @@
 // The viewer's z-up orbit camera and the screen <-> world maps that picking and dragging use.
 // The renderer loads exactly these matrices into GL, so what the tests compute here is what is
 // drawn.
-//   eye = radius (cos(phi) cos(theta), sin(phi) cos(theta), sin(theta)), looking at the origin,
-//   z up; perspective with a vertical field of view fovY (as gluPerspective / gluLookAt).
+//   eye = center + radius (cos(phi) cos(theta), sin(phi) cos(theta), sin(theta)), looking at
+//   the centre (the origin until panned), z up; perspective with a vertical field of view fovY (as
+//   gluPerspective / gluLookAt).
 // Window coordinates are pixels with the origin at the top-left corner, y down (as GLUT's).
 #pragma once
 
@@ -17,7 +18,8 @@ namespace jello::viewer {
 struct Camera {
   double phi = std::numbers::pi / 6;    // rad, azimuth around z
   double theta = std::numbers::pi / 6;  // rad, elevation above the xy-plane, |theta| < pi/2
-  double radius = 7.0;                  // m, distance from the origin (the whole box in view)
+  double radius = 7.0;                  // m, distance from the centre (the whole box in view)
+  Vec3 center{};                        // m, the point looked at (middle-drag pans it)
   double fovY = 60.0;                   // degrees, vertical field of view
   double zNear = 0.01, zFar = 1000.0;   // m
 
@@ -31,6 +33,11 @@ struct Camera {
   void rotate(double dxPixels, double dyPixels);
   // Moves the eye closer (negative) or farther; the radius stays at least 0.5 m.
   void zoom(double metres);
+  // Zooms by a factor of the radius (0.9: 10% closer), between 0.5 m and 100 m.
+  void zoomBy(double factor);
+  // Middle-drag: moves the centre so that the scene follows the cursor (at the centre's depth)
+  // in a window `viewportHeight` pixels high.
+  void pan(double dxPixels, double dyPixels, int viewportHeight);
 };
 
 struct Viewport {

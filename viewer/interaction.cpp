@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace jello::viewer {
 
@@ -20,24 +21,37 @@ Eigen::VectorXd pushForce(int numPoints, double mass, const Vec3& accel) {
   return f;
 }
 
+PullSpring pullSpring(int points, double mass, double kElastic, double scale) {
+  PullSpring spring;
+  spring.stiffness = scale * (kElastic > 0.0 ? kElastic : 100.0);
+  spring.damping = 2.0 * std::sqrt(spring.stiffness * mass);
+  spring.maxForce = kMaxPullAcceleration * mass * points;
+  return spring;
+}
+
 Eigen::VectorXd pullForce(const Lattice& lattice, const State& state, int picked,
-                          const Vec3& target, double radius, double stiffness) {
+                          const Vec3& target, double radius, const PullSpring& spring) {
   const int n = lattice.n, count = lattice.numPoints();
   const auto rest = [&](int p) { return lattice.restPosition(p / (n * n), (p / n) % n, p % n); };
-  const Vec3 pull = (target - state.position(picked)) * stiffness;
   const Vec3 origin = rest(picked);
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * count);
+  std::vector<double> weights(static_cast<std::size_t>(count), 0.0);
+  double weightSum = 0.0;
   for (int p = 0; p < count; ++p) {
-    double w;
-    if (std::isinf(radius)) {
-      w = 1.0;
-    } else if (p == picked) {
-      w = 1.0;
-    } else {
+    double w = 1.0;
+    if (!std::isinf(radius) && p != picked) {
       const double d = norm(rest(p) - origin);
       w = d < radius ? 1.0 - d / radius : 0.0;
     }
-    if (w > 0.0) State::set(f, p, pull * w);
+    weights[static_cast<std::size_t>(p)] = w;
+    weightSum += w;
+  }
+  Vec3 pull = (target - state.position(picked)) * spring.stiffness;
+  const double total = norm(pull) * weightSum;
+  if (total > spring.maxForce) pull = pull * (spring.maxForce / total);
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * count);
+  for (int p = 0; p < count; ++p) {
+    const double w = weights[static_cast<std::size_t>(p)];
+    if (w > 0.0) State::set(f, p, (pull - state.velocity(p) * spring.damping) * w);
   }
   return f;
 }

@@ -1,5 +1,6 @@
 // jello: the interactive viewer.
-//   jello [WORLD] [--integrator NAME] [--dt S] [--record DIR --frames N] [--size WxH]
+//   jello [WORLD] [--integrator NAME] [--dt S] [--speed X | --course-time]
+//         [--record DIR --frames N] [--size WxH]
 // Exit codes: 0 done, 1 runtime failure (no display, a frame not written), 2 bad arguments or
 // world file, 3 the simulation diverged while recording or benchmarking.
 #include <CLI/CLI.hpp>
@@ -53,8 +54,14 @@ int main(int argc, char** argv) {
       ->needs(record);
   record->needs("--frames");
   app.add_option("--size", size, "Window size WxH in pixels")->capture_default_str();
-  app.add_flag("--realtime", opt.realTime,
-               "Advance by wall-clock time instead of the world's n*dt per frame");
+  app.add_option("--speed", opt.speed,
+                 "Playback speed: simulated seconds per wall second (also of a recording: "
+                 "15 frames per speed simulated seconds)")
+      ->check(jello::cli::range(jello::viewer::kMinSpeed, jello::viewer::kMaxSpeed))
+      ->capture_default_str();
+  app.add_flag("--course-time", opt.courseTime,
+               "The original pacing: each displayed (or recorded) frame advances the world's n*dt");
+  app.add_flag("!--no-panel", opt.panel, "Start with the panel hidden (key m shows it)");
   app.add_flag("--wireframe", opt.wireframe, "Start in wireframe mode");
   app.add_flag("!--no-hud", opt.hud, "Hide the heads-up line");
   app.add_option("--benchmark", opt.benchmarkFrames,

@@ -1,6 +1,8 @@
 #include "viewer/renderer.h"
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 
 // glWindowPos (GL 1.4) is declared only with the extension prototypes.
 #define GL_GLEXT_PROTOTYPES
@@ -153,30 +155,117 @@ void drawText(int x, int y, const std::string& text) {
   glutBitmapString(GLUT_BITMAP_8_BY_13, reinterpret_cast<const unsigned char*>(text.c_str()));
 }
 
+constexpr int kLineHeight = 16, kCharWidth = 8;
+
+// Lines of text on a translucent dark backing; `top` is the first line's baseline, from the
+// window's bottom (GL's window coordinates).
+void drawTextBlock(const Viewport& viewport, const std::vector<std::string>& lines, int x, int top,
+                   const float colour[3], float alpha) {
+  if (lines.empty()) return;
+  std::size_t longest = 0;
+  for (const std::string& line : lines) longest = std::max(longest, line.size());
+  const int w = static_cast<int>(longest) * kCharWidth + 8;
+  const int h = static_cast<int>(lines.size()) * kLineHeight + 4;
+  glMatrixMode(GL_PROJECTION);
+  glPushMatrix();
+  glLoadIdentity();
+  glOrtho(0.0, viewport.width, 0.0, viewport.height, -1.0, 1.0);
+  glMatrixMode(GL_MODELVIEW);
+  glPushMatrix();
+  glLoadIdentity();
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  glColor4f(0.0f, 0.0f, 0.0f, 0.6f * alpha);
+  glRectd(x - 4, top + kLineHeight - 3, x - 4 + w, top + kLineHeight - 3 - h);
+  glColor4f(colour[0], colour[1], colour[2], alpha);
+  int y = top;
+  for (const std::string& line : lines) {
+    drawText(x, y, line);
+    y -= kLineHeight;
+  }
+  glDisable(GL_BLEND);
+  glPopMatrix();
+  glMatrixMode(GL_PROJECTION);
+  glPopMatrix();
+  glMatrixMode(GL_MODELVIEW);
+}
+
 void drawOverlay(const Viewport& viewport, const ViewerState& view, const Overlay& overlay) {
   glDisable(GL_DEPTH_TEST);
-  const std::size_t width = static_cast<std::size_t>(std::max(8, viewport.width / 8 - 2));
+  const std::size_t width = static_cast<std::size_t>(std::max(8, viewport.width / kCharWidth - 2));
   if (view.showHud && !overlay.hud.empty()) {
-    glColor3f(0.92f, 0.92f, 0.92f);
-    int y = viewport.height - 18;
-    for (const std::string& line : wrapText(overlay.hud, width)) {
-      drawText(8, y, line);
-      y -= 16;
-    }
+    static constexpr float white[3] = {0.92f, 0.92f, 0.92f};
+    drawTextBlock(viewport, wrapText(overlay.hud, width), 8, viewport.height - 18, white, 1.0f);
   }
-  if (!overlay.message.empty()) {
-    if (overlay.alarm) {
-      glColor3f(1.0f, 0.35f, 0.3f);
-    } else {
-      glColor3f(0.6f, 1.0f, 0.6f);
-    }
+  if (!overlay.help.empty()) {
+    static constexpr float pale[3] = {0.85f, 0.9f, 1.0f};
+    const std::vector<std::string> lines = wrapText(overlay.help, width);
+    const int top = std::min(viewport.height - 60, 30 + kLineHeight * int(lines.size()));
+    drawTextBlock(viewport, lines, 16, top, pale, 1.0f);
+  }
+  if (!overlay.message.empty() && overlay.messageAlpha > 0.0f) {
+    static constexpr float red[3] = {1.0f, 0.4f, 0.35f}, green[3] = {0.6f, 1.0f, 0.6f};
     const std::vector<std::string> lines = wrapText(overlay.message, width);
-    int y = 10 + 16 * static_cast<int>(lines.size() - 1);
-    for (const std::string& line : lines) {
-      drawText(8, y, line);
-      y -= 16;
-    }
+    drawTextBlock(viewport, lines, 8, 10 + kLineHeight * static_cast<int>(lines.size() - 1),
+                  overlay.alarm ? red : green, overlay.messageAlpha);
   }
+  glEnable(GL_DEPTH_TEST);
+}
+
+// The pull: the picked point, the cursor's target, the line between them, and the fall-off
+// radius as a circle around the picked point facing the camera.
+void drawPull(const ViewerState& view, const Scene& scene) {
+  const auto& [picked, target] = *scene.pull;
+  glDisable(GL_DEPTH_TEST);
+  glColor3f(1.0f, 0.85f, 0.2f);
+  glLineWidth(2.0f);
+  glBegin(GL_LINES);
+  vertex(picked);
+  vertex(target);
+  glEnd();
+  glPointSize(8.0f);
+  glBegin(GL_POINTS);
+  vertex(picked);
+  glColor3f(1.0f, 1.0f, 1.0f);
+  vertex(target);
+  glEnd();
+  const double r = scene.pullRadius;
+  if (r > 0.0 && std::isfinite(r)) {
+    const Vec3 a = view.camera.right(), b = view.camera.up();
+    glColor3f(1.0f, 0.85f, 0.2f);
+    glLineWidth(1.0f);
+    glBegin(GL_LINE_LOOP);
+    for (int i = 0; i < 48; ++i) {
+      const double phi = 2.0 * std::numbers::pi * i / 48;
+      vertex(picked + a * (r * std::cos(phi)) + b * (r * std::sin(phi)));
+    }
+    glEnd();
+  }
+  glLineWidth(1.0f);
+  glEnable(GL_DEPTH_TEST);
+}
+
+// The push: an arrow from the cube's centre in the pushed direction.
+void drawPush(const ViewerState& view, const Scene& scene) {
+  const auto& [from, to] = *scene.push;
+  const Vec3 d = to - from;
+  const double length = norm(d);
+  if (length <= 0.0) return;
+  const Vec3 u = d * (1.0 / length), side = cross(u, view.camera.forward());
+  const double head = std::min(0.25, 0.4 * length);
+  const Vec3 s = norm(side) > 0.0 ? side * (head * 0.5 / norm(side)) : Vec3{};
+  glDisable(GL_DEPTH_TEST);
+  glColor3f(0.3f, 0.8f, 1.0f);
+  glLineWidth(3.0f);
+  glBegin(GL_LINES);
+  vertex(from);
+  vertex(to);
+  vertex(to);
+  vertex(to - u * head + s);
+  vertex(to);
+  vertex(to - u * head - s);
+  glEnd();
+  glLineWidth(1.0f);
   glEnable(GL_DEPTH_TEST);
 }
 
@@ -223,13 +312,8 @@ void drawFrame(const ViewerState& view, const Viewport& viewport, const Scene& s
   }
   if (scene.world->sphere) drawSphere(*scene.world->sphere);
   if (view.showField && scene.arrows) drawArrows(*scene.arrows);
-  if (scene.pull) {
-    glColor3f(1.0f, 1.0f, 0.2f);
-    glBegin(GL_LINES);
-    vertex(scene.pull->first);
-    vertex(scene.pull->second);
-    glEnd();
-  }
+  if (scene.pull) drawPull(view, scene);
+  if (scene.push) drawPush(view, scene);
   if (scene.world->plane) drawPlane(*scene.world->plane);  // blended: last
   drawOverlay(viewport, view, overlay);
 }

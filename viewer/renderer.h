@@ -26,12 +26,16 @@ struct Scene {
   const std::vector<Spring>* springs = nullptr;  // surface springs
   const std::vector<Arrow>* arrows = nullptr;    // field arrows
   std::optional<std::pair<Vec3, Vec3>> pull;     // picked point and its target, while pulling
+  double pullRadius = 0.0;                       // m, the pull's fall-off radius (rest length)
+  std::optional<std::pair<Vec3, Vec3>> push;     // from the cube's centre along the push
 };
 
 struct Overlay {
-  std::string hud;      // the heads-up line
-  std::string message;  // an error or notice, drawn in its own colour
-  bool alarm = false;   // the message is an error (red) rather than a notice
+  std::string hud;            // the heads-up line
+  std::string message;        // an error or notice, drawn in its own colour on a dark backing
+  bool alarm = false;         // the message is an error (red) rather than a notice
+  float messageAlpha = 1.0f;  // fades out
+  std::string help;           // drawn in the middle when not empty (the key table)
 };
 
 // Once, after the window exists: depth test, lights, materials.

@@ -9,16 +9,21 @@
 #include <cstdlib>
 #include <iostream>
 #include <sstream>
+#include <thread>
 
 #include "viewer/image_writer.h"
 #include "viewer/interaction.h"
 #include "viewer/renderer.h"
+#include "viewer/sim_runner.h"
 #include "viewer/viewer_state.h"
 
 namespace jello::viewer {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+constexpr double kInteractiveFps = 60.0;  // interactive drawing is capped at this rate
+constexpr double kNoticeSeconds = 4.0, kAlarmSeconds = 8.0, kFadeSeconds = 1.0;
 
 std::string format(const char* fmt, double value) {
   char buf[64];
@@ -30,12 +35,37 @@ double seconds(Clock::duration d) {
   return std::chrono::duration<double>(d).count();
 }
 
+// "jello-000.w", "jello-001.w", ...: the first that does not exist.
+std::optional<std::string> freeName(const char* pattern) {
+  for (int i = 0; i < 1000; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, pattern, i);
+    if (!std::filesystem::exists(name)) return std::string(name);
+  }
+  return std::nullopt;
+}
+
+SimRunner::Options runnerOptions(const ViewerOptions& options) {
+  SimRunner::Options r;
+  const bool recording = !options.recordDir.empty();
+  r.pacing = recording || options.courseTime ? Pacing::Target : Pacing::RealTime;
+  r.speed = options.speed;
+  return r;
+}
+
 class Viewer {
  public:
   Viewer(const ViewerOptions& options, World world)
-      : options_(options), session_(options.source, std::move(world)), viewport_(options.size) {
+      : options_(options),
+        runner_(options.source, std::move(world), runnerOptions(options)),
+        viewport_(options.size) {
     view_.mode = options.wireframe ? DisplayMode::Wireframe : DisplayMode::Shaded;
     view_.showHud = options.hud;
+    view_.showPanel = options.panel;
+    view_.speed = options.speed;
+    frame_ = runner_.frame();
+    recordSpan_ = recordedFrameSpan(options.speed, options.courseTime, frame_.geometry->frameTime);
+    recordStart_ = frame_.state.t;
   }
 
   void display();
@@ -43,50 +73,77 @@ class Viewer {
   void key(unsigned char key);
   void mouse(int button, int state, int x, int y);
   void motion(int x, int y);
+  void idle();
   int exitCode() const { return exitCode_; }
 
  private:
-  void advance();
+  bool recording() const { return !options_.recordDir.empty(); }
+  void waitForRecordedFrame();
   void capture(const std::filesystem::path& path);
   void screenshot();
   void notify(std::string message, bool alarm) {
-    overlay_.message = std::move(message);
-    overlay_.alarm = alarm;
+    message_ = std::move(message);
+    alarm_ = alarm;
+    messageTime_ = Clock::now();
   }
+  void takeNotices();
+  Overlay overlay() const;
   std::string hudLine() const;
+  Scene scene() const;
   void leave(int code) {
     exitCode_ = code;
     glutLeaveMainLoop();
   }
   double pullRadius() const { return pullRadii()[static_cast<std::size_t>(view_.pullRadius)]; }
+  std::string restartHint() const;
 
   ViewerOptions options_;
-  ViewerSession session_;
+  SimRunner runner_;
+  Frame frame_;
   ViewerState view_;
   Viewport viewport_;
-  Overlay overlay_;
+  std::string message_;
+  bool alarm_ = false;
+  Clock::time_point messageTime_ = Clock::now();
+  bool divergenceShown_ = false;
   int exitCode_ = 0;
   bool screenshotPending_ = false;
   int framesDrawn_ = 0;
+  double recordSpan_ = 0.0, recordStart_ = 0.0;
+  long drawnPublished_ = -1;
 
-  enum class Drag { None, Rotate, Push, Pull } drag_ = Drag::None;
+  enum class Drag { None, Rotate, Pan, Push, Pull } drag_ = Drag::None;
   int lastX_ = 0, lastY_ = 0, pressX_ = 0, pressY_ = 0;
   Vec3 anchor_;  // the picked point where the pull began: the drag plane goes through it
+  Vec3 pushAccel_;
 
-  // Rates over the last half second.
-  Clock::time_point started_ = Clock::now(), rateWindow_ = Clock::now(),
-                    lastAdvance_ = Clock::now();
+  Clock::time_point started_ = Clock::now(), rateWindow_ = Clock::now(), lastDraw_ = Clock::now();
   int windowFrames_ = 0;
-  double windowSimTime_ = 0.0, fps_ = 0.0, realTimeFactor_ = 0.0;
+  double fps_ = 0.0;
 };
 
+std::string Viewer::restartHint() const {
+  return " - press r to reload the world (then 1-" + std::to_string(allIntegrators().size() % 10) +
+         " picks an integrator, - a smaller time step)";
+}
+
 std::string Viewer::hudLine() const {
-  const Simulation& sim = session_.simulation();
   std::ostringstream os;
-  os << integratorName(sim.integratorKind()) << "  dt " << format("%.3g", sim.dt()) << " s  t "
-     << format("%.3f", sim.state().t) << " s  " << format("%.0f", fps_) << " fps  "
-     << format("%.3g", realTimeFactor_) << "x real time  E "
-     << format("%.4g", sim.model().energy(sim.state()).total()) << " J";
+  os << integratorName(frame_.integrator) << "  dt " << format("%.3g", frame_.dt) << " s  t "
+     << format("%.3f", frame_.state.t) << " s  ";
+  if (options_.courseTime) {
+    os << "course time (n*dt per frame)";
+  } else {
+    os << "speed " << format("%.4g", frame_.speed) << "x";
+  }
+  os << "  " << format("%.0f", fps_) << " fps  E " << format("%.4g", frame_.energy.total()) << " J";
+  const bool behind = frame_.lagging && !frame_.paused && !frame_.divergence;
+  const bool slow = !options_.courseTime && !frame_.paused && frame_.simRate < 0.9 * frame_.speed &&
+                    !frame_.divergence;
+  if (behind || slow) {
+    os << "\nbehind: simulating " << format("%.3g", frame_.simRate)
+       << " s per wall second (speed asks " << format("%.4g", frame_.speed) << ")";
+  }
   if (view_.paused || view_.pullMode || drag_ == Drag::Pull) os << '\n';
   if (view_.paused) os << "[paused]  ";
   if (view_.pullMode || drag_ == Drag::Pull) {
@@ -96,19 +153,64 @@ std::string Viewer::hudLine() const {
   return os.str();
 }
 
-void Viewer::advance() {
-  const Clock::time_point now = Clock::now();
-  double frameTime = session_.frameTime();
-  if (options_.realTime) frameTime = std::min(0.1, seconds(now - lastAdvance_));
-  lastAdvance_ = now;
-  const double t0 = session_.simulation().state().t;
-  const bool divergedBefore = session_.simulation().divergence().has_value();
-  if (std::optional<std::string> failure = session_.advance(frameTime)) {
-    view_.paused = true;
-    notify(*failure + " - press r to reload", true);
-    if (!divergedBefore) std::cerr << "jello: " << *failure << '\n';
+Overlay Viewer::overlay() const {
+  Overlay o;
+  o.hud = hudLine();
+  if (view_.showHelp) o.help = "Keys and mouse (? closes):\n" + keyTable();
+  if (frame_.divergence) {  // stays until the scene is restarted
+    o.message = *frame_.divergence + restartHint();
+    o.alarm = true;
+    return o;
   }
-  windowSimTime_ += session_.simulation().state().t - t0;
+  o.message = message_;
+  o.alarm = alarm_;
+  const double age = seconds(Clock::now() - messageTime_);
+  const double life = alarm_ ? kAlarmSeconds : kNoticeSeconds;
+  o.messageAlpha =
+      static_cast<float>(std::clamp((life + kFadeSeconds - age) / kFadeSeconds, 0.0, 1.0));
+  return o;
+}
+
+Scene Viewer::scene() const {
+  const SceneGeometry& g = *frame_.geometry;
+  Scene s;
+  s.world = &g.world;
+  s.state = &frame_.state;
+  s.mesh = &g.mesh;
+  s.springs = &g.springs;
+  s.arrows = &g.arrows;
+  if (frame_.pull) {
+    s.pull = std::pair(frame_.state.position(frame_.pull->first), frame_.pull->second);
+    s.pullRadius = pullRadius();
+  }
+  if (drag_ == Drag::Push && norm(pushAccel_) > 0.0) {
+    Vec3 centre;
+    const int n = frame_.state.numPoints();
+    for (int p = 0; p < n; ++p) centre = centre + frame_.state.position(p);
+    centre = centre * (1.0 / n);
+    s.push = std::pair(centre, centre + pushAccel_ * 0.1);  // 10 cm per m/s^2
+  }
+  return s;
+}
+
+void Viewer::takeNotices() {
+  for (Notice& n : runner_.takeNotices()) {
+    if (n.alarm) std::cerr << "jello: " << n.text << '\n';
+    notify(std::move(n.text), n.alarm);
+  }
+}
+
+void Viewer::waitForRecordedFrame() {
+  // Frame i shows simulated time t0 + i * span: 300 frames play 20 s of animation at speed 1.
+  const double goal = recordStart_ + framesDrawn_ * recordSpan_;
+  runner_.setTarget(goal);
+  while (!runner_.waitFor(goal, 0.5)) {
+    if (runner_.frame().divergence) return;
+    if (::isatty(STDERR_FILENO)) {
+      std::fprintf(stderr, "\rjello: frame %d of %d (simulating t = %.4g s)", framesDrawn_ + 1,
+                   options_.frames, runner_.frame().state.t);
+    }
+  }
 }
 
 void Viewer::capture(const std::filesystem::path& path) {
@@ -116,21 +218,23 @@ void Viewer::capture(const std::filesystem::path& path) {
 }
 
 void Viewer::display() {
-  const Simulation& sim = session_.simulation();
-  overlay_.hud = hudLine();
-  Scene scene{&sim.world(),       &sim.state(),
-              &session_.mesh(),   &session_.surfaceSprings(),
-              &session_.arrows(), {}};
-  if (auto p = session_.pulling())
-    scene.pull = std::pair(sim.state().position(p->first), p->second);
-  drawFrame(view_, viewport_, scene, overlay_);
+  if (recording()) waitForRecordedFrame();
+  frame_ = runner_.frame();
+  drawnPublished_ = runner_.published();
+  takeNotices();
+  if (frame_.divergence && !divergenceShown_) {
+    divergenceShown_ = true;
+    view_.paused = true;
+  }
+  if (!frame_.divergence) divergenceShown_ = false;
+  drawFrame(view_, viewport_, scene(), overlay());
+  lastDraw_ = Clock::now();
 
   if (screenshotPending_) {
     screenshotPending_ = false;
     screenshot();
   }
-  const bool recording = !options_.recordDir.empty();
-  if (recording) {
+  if (recording()) {
     char name[16];
     std::snprintf(name, sizeof name, "%03d.jpg", framesDrawn_);
     try {
@@ -146,89 +250,133 @@ void Viewer::display() {
   }
   ++framesDrawn_;
   ++windowFrames_;
+  if (options_.courseTime && !view_.paused) runner_.advanceTarget(frame_.geometry->frameTime);
 
   const Clock::time_point now = Clock::now();
   if (const double span = seconds(now - rateWindow_); span >= 0.5) {
     fps_ = windowFrames_ / span;
-    realTimeFactor_ = windowSimTime_ / span;
     windowFrames_ = 0;
-    windowSimTime_ = 0.0;
     rateWindow_ = now;
   }
 
-  const int target = recording ? options_.frames : options_.benchmarkFrames;
+  const int target = recording() ? options_.frames : options_.benchmarkFrames;
   if (target > 0) {
-    if (recording && ::isatty(STDERR_FILENO)) {
-      std::fprintf(stderr, "\rjello: frame %d of %d", framesDrawn_, target);
+    if (recording() && ::isatty(STDERR_FILENO)) {
+      std::fprintf(stderr, "\rjello: frame %d of %d (t = %.4g s)          ", framesDrawn_, target,
+                   frame_.state.t);
     }
+    if (frame_.divergence) return leave(3);
     if (framesDrawn_ >= target) {
-      if (recording) {
+      if (recording()) {
         if (::isatty(STDERR_FILENO)) std::fprintf(stderr, "\n");
-        std::printf("jello: wrote %d frames to %s (t = %.4g s)\n", framesDrawn_,
-                    options_.recordDir.c_str(), sim.state().t);
+        std::printf(
+            "jello: wrote %d frames to %s: simulated t = %.4g .. %.4g s (%s, %.4g s per frame; "
+            "%.4g s of animation at 15 frames/s)\n",
+            framesDrawn_, options_.recordDir.c_str(), recordStart_, frame_.state.t,
+            options_.courseTime ? "course time" : ("speed " + format("%.4g", view_.speed)).c_str(),
+            recordSpan_, framesDrawn_ / kRecordedFramesPerSecond);
       } else {
         const double elapsed = seconds(now - started_);
         const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-        std::printf("%d frames in %.3f s: %.1f frames/s (%s, %dx%d, %s, t = %.4g s; %s)\n",
-                    framesDrawn_, elapsed, framesDrawn_ / elapsed,
-                    view_.mode == DisplayMode::Shaded ? "shaded" : "wireframe", viewport_.width,
-                    viewport_.height, std::string(integratorName(sim.integratorKind())).c_str(),
-                    sim.state().t, renderer ? renderer : "unknown renderer");
+        std::printf(
+            "%d frames in %.3f s: %.1f frames/s (%s, %dx%d, %s, t = %.4g s, simulating %.3g s "
+            "per wall second%s; %s)\n",
+            framesDrawn_, elapsed, framesDrawn_ / elapsed,
+            view_.mode == DisplayMode::Shaded ? "shaded" : "wireframe", viewport_.width,
+            viewport_.height, std::string(integratorName(frame_.integrator)).c_str(),
+            frame_.state.t, frame_.state.t / elapsed, frame_.lagging ? ", lagging" : "",
+            renderer ? renderer : "unknown renderer");
       }
-      return leave(sim.divergence() ? 3 : 0);
+      return leave(0);
     }
   }
-  if (!view_.paused) advance();
-  if (sim.divergence() && target > 0) return leave(3);
+}
+
+void Viewer::idle() {
+  if (recording() || options_.benchmarkFrames > 0) return glutPostRedisplay();
+  // Paused with nothing new to show: idle instead of redrawing the same picture.
+  const bool fading = !message_.empty() &&
+                      seconds(Clock::now() - messageTime_) < kAlarmSeconds + kFadeSeconds + 0.1;
+  const bool still = (view_.paused || frame_.divergence) && drag_ == Drag::None && !fading &&
+                     runner_.published() == drawnPublished_;
+  if (still) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    return;
+  }
+  const double wait = 1.0 / kInteractiveFps - seconds(Clock::now() - lastDraw_);
+  if (wait > 0.0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
+  glutPostRedisplay();
 }
 
 void Viewer::screenshot() {
-  for (int i = 0; i < 1000; ++i) {
-    char name[32];
-    std::snprintf(name, sizeof name, "jello-%03d.jpg", i);
-    if (std::filesystem::exists(name)) continue;
-    try {
-      capture(name);
-      notify(std::string("saved ") + name, false);
-    } catch (const std::exception& e) {
-      notify(e.what(), true);
-    }
-    return;
+  const std::optional<std::string> name = freeName("jello-%03d.jpg");
+  if (!name) return notify("jello-000.jpg ... jello-999.jpg all exist: screenshot not saved", true);
+  try {
+    capture(*name);
+    notify("saved " + *name, false);
+  } catch (const std::exception& e) {
+    notify(e.what(), true);
   }
-  notify("jello-000.jpg ... jello-999.jpg all exist: screenshot not saved", true);
 }
 
 void Viewer::key(unsigned char key) {
   const KeyResult result = handleKey(view_, key);
-  Simulation& sim = session_.simulation();
   switch (result.command) {
     case Command::Quit:
       return leave(0);
     case Command::Screenshot:
       screenshotPending_ = true;
       break;
-    case Command::Reload:
-      if (std::optional<std::string> error = session_.reload()) {
-        notify("reload failed, scene kept: " + *error, true);
-        std::cerr << "jello: reload failed: " << *error << '\n';
-      } else {
-        view_.dtScale = 1.0;
-        view_.paused = false;
-        drag_ = Drag::None;
-        notify("reloaded " + options_.source.world.string(), false);
-      }
+    case Command::Reload: {
+      const std::string file = options_.source.world.string();
+      runner_.post(
+          [this, file](ViewerSession& s) {
+            if (std::optional<std::string> error = s.reload()) {
+              runner_.notify({"reload failed, scene kept: " + *error, true});
+            } else {
+              runner_.notify({"reloaded " + file, false});
+            }
+          },
+          true);
+      view_.dtScale = 1.0;
+      view_.paused = false;
+      runner_.setPaused(false);
+      drag_ = Drag::None;
       break;
+    }
     case Command::SwitchIntegrator:
-      if (!sim.divergence()) {
-        sim.setIntegrator(*result.integrator);
-        notify("integrator " + std::string(integratorName(*result.integrator)), false);
+      if (frame_.divergence) {
+        notify("the simulation diverged" + restartHint(), true);
+        break;
       }
+      runner_.post(
+          [kind = *result.integrator](ViewerSession& s) { s.simulation().setIntegrator(kind); },
+          true);
+      notify("integrator " + std::string(integratorName(*result.integrator)), false);
       break;
     case Command::TimeStep:
-      session_.scaleTimeStep(view_.dtScale);
+      runner_.post([scale = view_.dtScale](ViewerSession& s) { s.scaleTimeStep(scale); }, true);
+      notify("time step x" + format("%.4g", view_.dtScale) + " of the world's", false);
       break;
     case Command::StepOnce:
-      if (view_.paused) advance();
+      if (view_.paused) runner_.stepFrame();
+      break;
+    case Command::Pause:
+      runner_.setPaused(view_.paused);
+      break;
+    case Command::Speed:
+      runner_.setSpeed(view_.speed);
+      notify("playback speed " + format("%.4g", view_.speed) + "x" +
+                 (options_.courseTime ? " (ignored in course time)" : ""),
+             false);
+      break;
+    case Command::SaveWorld:
+      runner_.post([this](ViewerSession& s) {
+        const std::optional<std::string> name = freeName("jello-%03d.w");
+        if (!name) throw std::runtime_error("jello-000.w ... jello-999.w all exist: not saved");
+        s.save(*name);
+        runner_.notify({"saved the current state as " + *name, false});
+      });
       break;
     case Command::None:
       break;
@@ -239,35 +387,53 @@ void Viewer::key(unsigned char key) {
 void Viewer::mouse(int button, int state, int x, int y) {
   lastX_ = pressX_ = x;
   lastY_ = pressY_ = y;
+  if (button == 3 || button == 4) {  // freeglut reports the wheel as buttons 3 and 4
+    if (state == GLUT_DOWN) view_.camera.zoomBy(button == 3 ? 0.9 : 1.0 / 0.9);
+    return glutPostRedisplay();
+  }
   if (state == GLUT_UP) {
+    if (drag_ == Drag::Push || drag_ == Drag::Pull) {
+      runner_.post([](ViewerSession& s) { s.release(); });
+    }
     drag_ = Drag::None;
-    session_.release();
     return;
   }
   if (button == GLUT_RIGHT_BUTTON) {
     drag_ = Drag::Rotate;
+  } else if (button == GLUT_MIDDLE_BUTTON) {
+    drag_ = Drag::Pan;
   } else if (button == GLUT_LEFT_BUTTON) {
-    const State& s = session_.simulation().state();
     const bool pull = view_.pullMode || (glutGetModifiers() & GLUT_ACTIVE_SHIFT);
     if (!pull) {
       drag_ = Drag::Push;
-    } else if (auto p = pickPoint(view_.camera, viewport_, session_.mesh(), s, x, y)) {
+      pushAccel_ = {};
+    } else if (auto p =
+                   pickPoint(view_.camera, viewport_, frame_.geometry->mesh, frame_.state, x, y)) {
       drag_ = Drag::Pull;
-      anchor_ = s.position(*p);
-      session_.pull(*p, anchor_, pullRadius());
+      anchor_ = frame_.state.position(*p);
+      runner_.post(
+          [p = *p, anchor = anchor_, r = pullRadius()](ViewerSession& s) { s.pull(p, anchor, r); });
     }
   }
 }
 
 void Viewer::motion(int x, int y) {
   if (drag_ == Drag::Rotate) view_.camera.rotate(x - lastX_, y - lastY_);
+  if (drag_ == Drag::Pan) view_.camera.pan(x - lastX_, y - lastY_, viewport_.height);
   lastX_ = x;
   lastY_ = y;
   if (drag_ == Drag::Push) {
-    session_.push(screenDragToWorld(view_.camera, x - pressX_, y - pressY_) * kPushPerPixel);
-  } else if (auto pulled = session_.pulling()) {  // the session keeps the picked point
-    session_.pull(pulled->first, dragTarget(view_.camera, viewport_, x, y, anchor_), pullRadius());
+    Vec3 a = screenDragToWorld(view_.camera, x - pressX_, y - pressY_) * kPushPerPixel;
+    if (norm(a) > kMaxPullAcceleration) a = a * (kMaxPullAcceleration / norm(a));
+    pushAccel_ = a;
+    runner_.post([a](ViewerSession& s) { s.push(a); });
+  } else if (drag_ == Drag::Pull) {
+    const Vec3 target = dragTarget(view_.camera, viewport_, x, y, anchor_);
+    runner_.post([target, r = pullRadius()](ViewerSession& s) {
+      if (auto pulled = s.pulling()) s.pull(pulled->first, target, r);
+    });
   }
+  glutPostRedisplay();
 }
 
 Viewer* active = nullptr;  // GLUT's callbacks take no context pointer
@@ -295,29 +461,34 @@ int runViewer(const ViewerOptions& options, World world) {
   char* argv[] = {program, nullptr};
   glutInit(&argc, argv);
   glutSetOption(GLUT_ACTION_ON_WINDOW_CLOSE, GLUT_ACTION_GLUTMAINLOOP_RETURNS);
-  glutInitDisplayMode(GLUT_DOUBLE | GLUT_RGB | GLUT_DEPTH);
+  glutSetOption(GLUT_MULTISAMPLE, 4);
+  glutInitDisplayMode(GLUT_DOUBLE | GLUT_RGB | GLUT_DEPTH | GLUT_MULTISAMPLE);
   glutInitWindowSize(options.size.width, options.size.height);
   const int window = glutCreateWindow("jello");
   if (window <= 0) {
     std::cerr << "jello: cannot create a window\n";
     return 1;
   }
-  Viewer viewer(options, std::move(world));
-  active = &viewer;
-  initRenderer();
-  glutDisplayFunc([] { active->display(); });
-  glutReshapeFunc([](int w, int h) { active->reshape(w, h); });
-  glutKeyboardFunc([](unsigned char k, int, int) { active->key(k); });
-  glutMouseFunc([](int b, int s, int x, int y) { active->mouse(b, s, x, y); });
-  glutMotionFunc([](int x, int y) { active->motion(x, y); });
-  glutIdleFunc([] { glutPostRedisplay(); });
-  glutMainLoop();
-  active = nullptr;
+  int exitCode = 0;
+  {
+    Viewer viewer(options, std::move(world));
+    active = &viewer;
+    initRenderer();
+    glutDisplayFunc([] { active->display(); });
+    glutReshapeFunc([](int w, int h) { active->reshape(w, h); });
+    glutKeyboardFunc([](unsigned char k, int, int) { active->key(k); });
+    glutMouseFunc([](int b, int s, int x, int y) { active->mouse(b, s, x, y); });
+    glutMotionFunc([](int x, int y) { active->motion(x, y); });
+    glutIdleFunc([] { active->idle(); });
+    glutMainLoop();
+    active = nullptr;
+    exitCode = viewer.exitCode();
+  }  // the simulation thread stops here, a long step cut short
   // The window is still open when the loop returns after glutLeaveMainLoop: close it and let
   // freeglut release its state, so the GL driver's memory is freed before exit.
   if (glutGetWindow() == window) glutDestroyWindow(window);
   glutExit();
-  return viewer.exitCode();
+  return exitCode;
 }
 
 }  // namespace jello::viewer

@@ -1,6 +1,7 @@
-// The interactive viewer: a GLUT window over one Simulation, with the keys of viewer_state.h,
-// mouse push and pull, reload, screenshots, recording to numbered JPEGs and a frame-rate
-// benchmark. The only file besides renderer.cpp that talks to GLUT.
+// The interactive viewer: a GLUT window over a SimRunner (the simulation on its own thread),
+// with the keys of viewer_state.h, mouse push and pull, reload, screenshots, recording to
+// numbered JPEGs (15 per simulated second times the speed) and a frame-rate benchmark. The only
+// file besides renderer.cpp and panel.cpp that talks to GLUT.
 #pragma once
 
 #include <filesystem>
@@ -20,9 +21,11 @@ struct ViewerOptions {
   std::filesystem::path recordDir;  // non-empty: record `frames` frames and exit
   int frames = 0;
   Viewport size;
-  bool realTime = false;   // advance by wall-clock time instead of n*dt per frame
-  bool wireframe = false;  // start in wireframe
+  double speed = 1.0;       // playback: simulated seconds per wall second
+  bool courseTime = false;  // the original pacing: the world's n*dt per displayed frame
+  bool wireframe = false;   // start in wireframe
   bool hud = true;
+  bool panel = true;
   int benchmarkFrames = 0;  // > 0: draw this many frames as fast as possible, print frames/s
 };
 

@@ -1,9 +1,27 @@
 #include "viewer/viewer_session.h"
 
-#include "viewer/interaction.h"
+#include "src/world_writer.h"
 #include "viewer/viewer_state.h"
 
 namespace jello::viewer {
+
+namespace {
+
+std::shared_ptr<const SceneGeometry> makeGeometry(const Simulation& sim) {
+  auto g = std::make_shared<SceneGeometry>();
+  g->lattice = Lattice{sim.world().cubeResolution};
+  g->mesh = surfaceMesh(g->lattice);
+  g->springs = surfaceSprings(sim.model().springs().springs(), g->lattice);
+  g->arrows = fieldArrows(sim.world().field);
+  g->frameTime = sim.world().stepsPerFrame * sim.world().dt;
+  g->world = sim.world();
+  g->world.field = {};
+  g->world.positions.clear();
+  g->world.velocities.clear();
+  return g;
+}
+
+}  // namespace
 
 ViewerSession::ViewerSession(SceneSource source, World world) : source_(std::move(source)) {
   build(std::move(world));
@@ -11,12 +29,8 @@ ViewerSession::ViewerSession(SceneSource source, World world) : source_(std::mov
 
 void ViewerSession::build(World world) {
   sim_ = std::make_unique<Simulation>(std::move(world), source_.integrator, source_.dt);
-  lattice_ = Lattice{sim_->world().cubeResolution};
-  mesh_ = surfaceMesh(lattice_);
-  springs_ = viewer::surfaceSprings(sim_->model().springs().springs(), lattice_);
-  arrows_ = fieldArrows(sim_->world().field);
+  geometry_ = makeGeometry(*sim_);
   dt0_ = sim_->dt();
-  frameTime_ = sim_->world().stepsPerFrame * sim_->world().dt;
   drag_ = Drag::None;
 }
 
@@ -31,12 +45,33 @@ std::optional<std::string> ViewerSession::reload() {
   return std::nullopt;
 }
 
+void ViewerSession::editWorld(const std::function<void(World&)>& edit) {
+  World world = sim_->currentWorld();
+  edit(world);
+  const IntegratorKind kind = sim_->integratorKind();
+  const SolverOptions options = sim_->solverOptions();
+  const double dt = sim_->dt(), t = sim_->state().t;
+  sim_ = std::make_unique<Simulation>(std::move(world), kind, dt, options);
+  sim_->editableState().t = t;
+  sim_->stateEdited();
+  geometry_ = makeGeometry(*sim_);
+  if (drag_ == Drag::None) sim_->clearUserForce();
+}
+
+void ViewerSession::save(const std::filesystem::path& path) const {
+  writeWorld(sim_->currentWorld(), path);
+}
+
+StepResult ViewerSession::step() {
+  applyUserForce();
+  return sim_->step();
+}
+
 std::optional<std::string> ViewerSession::advance(double frameTime) {
   if (sim_->divergence()) return sim_->divergence()->describe();
-  applyUserForce();
   const int steps = stepsPerFrame(frameTime, sim_->dt());
   for (int i = 0; i < steps; ++i) {
-    if (StepResult r = sim_->step(); !r.ok) return r.message;
+    if (StepResult r = step(); !r.ok) return r.message;
   }
   return std::nullopt;
 }
@@ -46,9 +81,8 @@ void ViewerSession::applyUserForce() {
   if (drag_ == Drag::Push) {
     sim_->setUserForce(pushForce(sim_->model().numPoints(), w.mass, accel_));
   } else if (drag_ == Drag::Pull) {
-    // Stiff enough to move a point against its springs; the lattice's own k sets the scale.
-    const double k = w.kElastic > 0.0 ? w.kElastic : 100.0;
-    sim_->setUserForce(pullForce(lattice_, sim_->state(), picked_, target_, radius_, k));
+    const PullSpring spring = pullSpring(sim_->model().numPoints(), w.mass, w.kElastic, pullScale_);
+    sim_->setUserForce(pullForce(lattice(), sim_->state(), picked_, target_, radius_, spring));
   }
 }
 

@@ -1,5 +1,6 @@
 #include "viewer/viewer_state.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <sstream>
@@ -52,6 +53,20 @@ KeyResult handleKey(ViewerState& s, unsigned char key) {
       break;
     case 'p':
       s.paused = !s.paused;
+      return {Command::Pause, {}};
+    case '<':
+      s.speed = std::max(kMinSpeed, s.speed * 0.5);
+      return {Command::Speed, {}};
+    case '>':
+      s.speed = std::min(kMaxSpeed, s.speed * 2.0);
+      return {Command::Speed, {}};
+    case 'w':
+      return {Command::SaveWorld, {}};
+    case 'm':
+      s.showPanel = !s.showPanel;
+      break;
+    case '?':
+      s.showHelp = !s.showHelp;
       break;
     case 'f':
       s.showField = !s.showField;
@@ -107,17 +122,22 @@ std::span<const KeyBinding> keyBindings() {
       {"Shift+left-drag", "pull the surface point under the cursor (also left-drag in pull mode)"},
       {"g", "pull mode on/off"},
       {"[ ]", "pull radius smaller/larger: one point ... the whole cube"},
-      {"z x", "zoom in/out"},
+      {"z x, wheel", "zoom in/out"},
+      {"middle-drag", "pan the camera"},
       {"e", "reset the camera"},
       {"v", "wireframe/shaded"},
       {"s h b", "wireframe: structural, shear, bend springs on/off"},
       {"p", "pause/resume"},
-      {".", "advance one frame while paused"},
+      {".", "advance one frame (the world's n*dt) while paused"},
+      {"< >", "playback speed /2, x2 (simulated seconds per wall second)"},
       integratorKeys(),
-      {"+ -", "time step x2, /2 (simulated time per frame stays n*dt of the world)"},
+      {"+ -", "time step x2, /2 (playback speed unchanged)"},
       {"r", "reload the world file (a bad file keeps the running scene)"},
       {"f", "force-field arrows on/off"},
       {"i", "heads-up line on/off"},
+      {"m", "panel on/off (constants, integrator, live plots)"},
+      {"?", "this key table on screen"},
+      {"w", "save the current state as a world file (jello-NNN.w)"},
       {"space", "save a screenshot (jello-NNN.jpg in the current directory)"},
       {"ESC", "quit"},
   };
@@ -151,6 +171,10 @@ std::vector<std::string> wrapText(const std::string& text, std::size_t width) {
 int stepsPerFrame(double frameTime, double dt) {
   const double steps = std::round(frameTime / dt);
   return steps < 1.0 ? 1 : steps > 1e6 ? 1000000 : int(steps);
+}
+
+double recordedFrameSpan(double speed, bool courseTime, double courseFrameTime) {
+  return courseTime ? courseFrameTime : speed / kRecordedFramesPerSecond;
 }
 
 }  // namespace jello::viewer

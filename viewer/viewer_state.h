@@ -26,7 +26,12 @@ struct ViewerState {
   bool pullMode = false;   // left-drag pulls the picked point (also with Shift held)
   int pullRadius = 0;      // index into pullRadii()
   double dtScale = 1.0;    // the time step is the starting one times this
+  double speed = 1.0;      // playback: simulated seconds per wall second (real time)
+  bool showPanel = true;   // the ImGui panel
+  bool showHelp = false;   // the key table on screen
 };
+
+inline constexpr double kMinSpeed = 1.0 / 1024, kMaxSpeed = 64.0;
 
 enum class Command {
   None,              // the state changed (or nothing did); redraw
@@ -36,6 +41,9 @@ enum class Command {
   SwitchIntegrator,  // 1-5: see KeyResult::integrator
   TimeStep,          // + / -: dtScale changed
   StepOnce,          // . : one frame while paused
+  Pause,             // p: paused changed
+  Speed,             // < >: speed changed
+  SaveWorld,         // w: save the current state as a world file
 };
 
 struct KeyResult {
@@ -58,8 +66,13 @@ std::string keyTable();  // "  keys  action" lines
 // long, at the last space that fits (or hard, when there is none).
 std::vector<std::string> wrapText(const std::string& text, std::size_t width);
 
-// Simulated seconds to advance per displayed frame, split into whole steps of at most dt:
-// the frame time is the world's n*dt0 (fixed when +/- change dt), at least one step.
+// Course time: simulated seconds to advance per displayed frame, split into whole steps of at
+// most dt: the frame time is the world's n*dt0 (fixed when +/- change dt), at least one step.
 int stepsPerFrame(double frameTime, double dt);
+
+// Recorded animations play at the course's 15 frames per second: each recorded frame covers
+// speed/15 simulated seconds, or the world's n*dt in course time.
+inline constexpr double kRecordedFramesPerSecond = 15.0;
+double recordedFrameSpan(double speed, bool courseTime, double courseFrameTime);
 
 }  // namespace jello::viewer

@@ -1,0 +1,209 @@
+// The viewer's simulation thread without GL: stepping never blocks the render thread, real-time
+// playback follows the wall clock times the speed (a fake clock drives it), a slow simulation
+// drops time and says so, recording covers 20 s in 300 frames, and the panel's edits, saving and
+// the heads-up energy are those of the model.
+#include "viewer/sim_runner.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include "src/world_reader.h"
+#include "tests/test_support.h"
+#include "viewer/viewer_state.h"
+
+namespace jello::viewer {
+namespace {
+
+using std::chrono::milliseconds;
+using WallClock = std::chrono::steady_clock;
+
+double secondsSince(WallClock::time_point start) {
+  return std::chrono::duration<double>(WallClock::now() - start).count();
+}
+
+// A clock the test sets by hand.
+struct FakeClock {
+  std::shared_ptr<std::atomic<double>> now = std::make_shared<std::atomic<double>>(100.0);
+  SimRunner::WallClock clock() const {
+    return [now = now] { return now->load(); };
+  }
+  void advance(double s) { now->store(now->load() + s); }
+};
+
+SimRunner::Options fakeClockOptions(const FakeClock& clock, double speed) {
+  SimRunner::Options o;
+  o.clock = clock.clock();
+  o.speed = speed;
+  return o;
+}
+
+SceneSource source(const std::string& name) {
+  return {test::worldsDir() / name, std::nullopt, std::nullopt, {}};
+}
+
+TEST(SimRunner, ASlowStepNeverDelaysTheRenderThread) {
+  std::atomic<bool> inStep{false};
+  SimRunner::Options o;
+  o.beforeStep = [&] {
+    inStep = true;
+    std::this_thread::sleep_for(milliseconds(400));  // a heavy integrator's step
+  };
+  SimRunner runner(source("jello.w"), test::loadWorld("jello.w"), o);
+  while (!inStep) std::this_thread::sleep_for(milliseconds(1));
+  // Everything the render thread does in a frame, keys included, while the step runs.
+  const auto start = WallClock::now();
+  for (int i = 0; i < 20; ++i) {
+    const Frame f = runner.frame();
+    EXPECT_EQ(f.state.numPoints(), 512);
+    runner.post([](ViewerSession& s) { s.push({1.0, 0.0, 0.0}); });
+    runner.setSpeed(i % 2 ? 1.0 : 2.0);
+    runner.setPaused(false);
+    (void)runner.takeNotices();
+  }
+  EXPECT_LT(secondsSince(start), 0.1);  // not one 400 ms step
+}
+
+TEST(SimRunner, QuittingCutsALongImplicitStepShort) {
+  // Backward Euler with one step of a whole second on the 16^3 cube: seconds of Newton work.
+  World w = test::loadWorld("cube16.w");
+  SimRunner::Options o;
+  o.speed = 1.0;
+  SceneSource src = source("cube16.w");
+  src.integrator = IntegratorKind::Cvode;
+  src.dt = 4.0;
+  auto runner = std::make_unique<SimRunner>(src, w, o);
+  std::this_thread::sleep_for(milliseconds(300));  // inside the first step
+  const auto start = WallClock::now();
+  runner.reset();
+  EXPECT_LT(secondsSince(start), 1.0);
+}
+
+TEST(SimRunner, RealTimePlaybackAdvancesSpeedTimesWallTime) {
+  FakeClock clock;
+  SimRunner runner(source("jello.w"), test::loadWorld("jello.w"), fakeClockOptions(clock, 2.0));
+  const double dt = runner.frame().dt;
+  for (int i = 1; i <= 20; ++i) {
+    clock.advance(0.05);
+    ASSERT_TRUE(runner.waitFor(2.0 * 0.05 * i - dt, 30.0)) << "at " << i;
+  }
+  std::this_thread::sleep_for(milliseconds(50));  // the clock stands still: so does the scene
+  const Frame f = runner.frame();
+  EXPECT_NEAR(f.state.t, 2.0, dt + 1e-9);  // 2 x 1 s of wall time, to one step
+  EXPECT_FALSE(f.lagging);
+  EXPECT_EQ(f.speed, 2.0);
+
+  runner.setPaused(true);
+  clock.advance(1.0);
+  std::this_thread::sleep_for(milliseconds(50));
+  EXPECT_EQ(runner.frame().state.t, f.state.t);  // paused: wall time passes, simulated does not
+  runner.stepFrame();                            // `.`: one frame of n*dt
+  ASSERT_TRUE(runner.waitFor(f.state.t + f.geometry->frameTime - 1e-9, 30.0));
+  std::this_thread::sleep_for(milliseconds(50));
+  EXPECT_NEAR(runner.frame().state.t, f.state.t + f.geometry->frameTime, 1e-9);
+
+  runner.setSpeed(0.5);
+  runner.setPaused(false);  // resumes from here, not from where the clock was
+  clock.advance(0.1);
+  ASSERT_TRUE(runner.waitFor(f.state.t + f.geometry->frameTime + 0.05 - dt, 30.0));
+  std::this_thread::sleep_for(milliseconds(50));
+  EXPECT_NEAR(runner.frame().state.t, f.state.t + f.geometry->frameTime + 0.05, dt + 1e-9);
+}
+
+TEST(SimRunner, ASimulationThatFallsBehindDropsTimeAndSaysItLags) {
+  FakeClock clock;
+  SimRunner runner(source("jello.w"), test::loadWorld("jello.w"), fakeClockOptions(clock, 1.0));
+  clock.advance(5.0);  // five wall seconds pass in one frame: far more than the backlog
+  ASSERT_TRUE(runner.waitFor(kMaxBacklog - 0.002, 30.0));
+  std::this_thread::sleep_for(milliseconds(50));
+  const Frame f = runner.frame();
+  EXPECT_NEAR(f.state.t, kMaxBacklog, 0.002);  // caught up the backlog only, not 5 s
+  EXPECT_TRUE(f.lagging);
+}
+
+TEST(SimRunner, RecordingCoversTwentySecondsInThreeHundredFrames) {
+  World w = test::loadWorld("jello.w");
+  SimRunner::Options o;
+  o.pacing = Pacing::Target;
+  SimRunner runner(source("jello.w"), w, o);
+  const double span = recordedFrameSpan(1.0, false, w.stepsPerFrame * w.dt);
+  EXPECT_DOUBLE_EQ(span, 1.0 / 15.0);
+  for (int i = 0; i < 300; ++i) {  // what the viewer's recording asks of the runner
+    runner.setTarget(i * span);
+    ASSERT_TRUE(runner.waitFor(i * span, 60.0)) << "frame " << i;
+    const Frame f = runner.frame();
+    ASSERT_NEAR(f.state.t, i * span, w.dt) << "frame " << i;  // the frame shows its own time
+  }
+  EXPECT_NEAR(runner.frame().state.t, 299.0 / 15.0, w.dt);  // 300 frames at 15/s: 20 s shown
+  EXPECT_FALSE(runner.frame().divergence.has_value());
+  // Course time: n*dt per frame instead.
+  EXPECT_DOUBLE_EQ(recordedFrameSpan(1.0, true, w.stepsPerFrame * w.dt), w.stepsPerFrame * w.dt);
+}
+
+TEST(SimRunner, PanelEditsReachTheModel) {
+  World w = test::loadWorld("jello.w");
+  SimRunner::Options o;
+  o.paused = true;
+  SimRunner runner(source("jello.w"), w, o);
+  const Frame before = runner.frame();
+  ASSERT_GT(before.energy.spring, 0.0);  // jello.w starts stretched
+  runner.post([](ViewerSession& s) { s.editWorld([](World& world) { world.kElastic *= 3.0; }); });
+  runner.sync();
+  const Frame after = runner.frame();
+  EXPECT_EQ(after.geometry->world.kElastic, 3.0 * w.kElastic);
+  EXPECT_GT(after.generation, before.generation);
+  EXPECT_NEAR(after.energy.spring, 3.0 * before.energy.spring, 1e-9 * before.energy.spring);
+  EXPECT_EQ(after.state.x, before.state.x);  // the state is kept
+  EXPECT_EQ(after.integrator, before.integrator);
+}
+
+TEST(SimRunner, ACommandThatFailsBecomesAnAlarmNotAStop) {
+  SimRunner::Options o;
+  o.paused = true;
+  SimRunner runner(source("jello.w"), test::loadWorld("jello.w"), o);
+  runner.post([](ViewerSession&) { throw std::runtime_error("disk full"); });
+  runner.sync();
+  const std::vector<Notice> notices = runner.takeNotices();
+  ASSERT_EQ(notices.size(), 1u);
+  EXPECT_EQ(notices[0].text, "disk full");
+  EXPECT_TRUE(notices[0].alarm);
+}
+
+TEST(ViewerSession, SavingWritesAWorldThatReloadsToTheSameState) {
+  test::TempDir dir;
+  ViewerSession session(source("jello.w"), test::loadWorld("jello.w"));
+  ASSERT_FALSE(session.advance(0.05).has_value());
+  const auto path = dir.path() / "saved.w";
+  session.save(path);
+  const World reloaded = readWorld(path);
+  const State s = initialState(reloaded);
+  EXPECT_EQ(s.x, session.simulation().state().x);
+  EXPECT_EQ(s.v, session.simulation().state().v);
+}
+
+TEST(ViewerSession, TheHeadsUpEnergyIncludesTheFieldAndRk4ConservesIt) {
+  // rotate.w without damping: only the field does work, so kinetic + spring + contact minus
+  // the field's work stays put.
+  World w = test::loadWorld("rotate.w");
+  w.dElastic = 0.0;
+  w.dCollision = 0.0;
+  ViewerSession session({"rotate.w", IntegratorKind::RK4, std::nullopt, {}}, w);
+  ASSERT_TRUE(session.simulation().model().hasField());
+  // It starts at rest: the field pumps in ~10 J in a second, which the field's share balances.
+  const double e0 = energyReport(session.simulation()).total();
+  double scale = 0.0;
+  for (int i = 0; i < 20; ++i) {
+    ASSERT_FALSE(session.advance(0.05).has_value());
+    const EnergyReport e = energyReport(session.simulation());
+    scale = std::max(scale, e.kinetic + e.spring + e.contact);
+    EXPECT_NEAR(e.total(), e0, 0.01 * scale) << "t = " << session.simulation().state().t;
+    EXPECT_NEAR(e.field, -session.simulation().fieldWork(), 0.0);
+  }
+  EXPECT_GT(scale, 5.0);  // J: the test is not of a cube at rest
+}
+
+}  // namespace
+}  // namespace jello::viewer
