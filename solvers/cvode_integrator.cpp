@@ -395,6 +395,8 @@ std::vector<Statistic> CvodeIntegrator::statistics() const {
   }
   int order = 0;
   if (CVodeGetLastOrder(mem, &order) == CV_SUCCESS) stats.push_back({"last_order", double(order)});
+  double lastStep = 0.0;
+  if (CVodeGetLastStep(mem, &lastStep) == CV_SUCCESS) stats.push_back({"last_step_s", lastStep});
   stats.push_back({"starts", double(restarts_)});  // 1 + restarts from a state set outside
   if (options_.contactRoots) stats.push_back({"contact_roots", double(roots_)});
   system_.appendStatistics(stats);

@@ -59,10 +59,12 @@ class Frames : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new test::TempDir;
-    for (const char* mode : {"shaded", "wireframe"}) {
+    for (const char* mode : {"shaded", "wireframe", "panel"}) {
       const std::string out = (dir_->path() / mode).string();
+      const std::string m = mode;
       const Outcome r = run(headless(world("jello.w") + " --no-hud --frames 1 --record " + out +
-                                     (std::string(mode) == "wireframe" ? " --wireframe" : "")));
+                                     (m == "wireframe" ? " --wireframe" : "") +
+                                     (m == "panel" ? " --panel" : "")));
       ASSERT_EQ(r.code, 0) << r.output;
     }
   }
@@ -155,6 +157,28 @@ TEST_F(Frames, WireframeAndShadedModesDiffer) {
   EXPECT_LT(lines, total);
 }
 
+TEST_F(Frames, ThePanelIsDrawnAtTheRightAndLeavesTheRestAlone) {
+  const Image plain = frame("shaded"), panel = frame("panel");
+  // Its column (250 px at the right edge, from y = 44) differs; the left half does not.
+  double inside = 0.0, outside = 0.0;
+  int nIn = 0, nOut = 0;
+  for (int y = 60; y < 300; ++y) {
+    for (int x = 0; x < 640; ++x) {
+      const Rgb a = pixel(plain, x, y), b = pixel(panel, x, y);
+      const double d = std::abs(a.r - b.r) + std::abs(a.g - b.g) + std::abs(a.b - b.b);
+      if (x > 400 && x < 630) {
+        inside += d;
+        ++nIn;
+      } else if (x < 360) {
+        outside += d;
+        ++nOut;
+      }
+    }
+  }
+  EXPECT_GT(inside / nIn, 20.0);  // text, frames and sliders over the scene
+  EXPECT_LT(outside / nOut, 1.0);
+}
+
 TEST(Recording, ThirtyFramesAreThirtyValidChangingJpegs) {
   test::TempDir dir;
   const auto out = dir.path() / "frames";
@@ -162,6 +186,8 @@ TEST(Recording, ThirtyFramesAreThirtyValidChangingJpegs) {
       run(headless(world("jello.w") + " --no-hud --frames 30 --record " + out.string()));
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("wrote 30 frames"), std::string::npos) << r.output;
+  // 15 frames per simulated second at speed 1: the last of 30 frames shows t = 29/15 s.
+  EXPECT_NE(r.output.find("simulated t = 0 .. 1.933 s"), std::string::npos) << r.output;
   Image previous;
   for (int i = 0; i < 30; ++i) {
     char name[16];

@@ -61,7 +61,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--course-time", opt.courseTime,
                "The original pacing: each displayed (or recorded) frame advances the world's n*dt");
-  app.add_flag("!--no-panel", opt.panel, "Start with the panel hidden (key m shows it)");
+  bool panel = false, noPanel = false;
+  app.add_flag("--panel", panel, "Show the panel in recordings too (it is shown interactively)");
+  app.add_flag("--no-panel", noPanel, "Start with the panel hidden (key m shows it)")
+      ->excludes("--panel");
   app.add_flag("--wireframe", opt.wireframe, "Start in wireframe mode");
   app.add_flag("!--no-hud", opt.hud, "Hide the heads-up line");
   app.add_option("--benchmark", opt.benchmarkFrames,
@@ -104,6 +107,7 @@ int main(int argc, char** argv) {
                         "' (known: " + jello::integratorNameList() + ")");
     }
   }
+  if (panel || noPanel) opt.panel = panel;
   opt.source.world = world;
   // With --integrator, a file naming an integrator we do not have still loads (with a warning).
   opt.source.limits.acceptUnknownIntegrator = opt.source.integrator.has_value();

@@ -13,6 +13,7 @@
 
 #include "viewer/image_writer.h"
 #include "viewer/interaction.h"
+#include "viewer/panel.h"
 #include "viewer/renderer.h"
 #include "viewer/sim_runner.h"
 #include "viewer/viewer_state.h"
@@ -61,7 +62,7 @@ class Viewer {
         viewport_(options.size) {
     view_.mode = options.wireframe ? DisplayMode::Wireframe : DisplayMode::Shaded;
     view_.showHud = options.hud;
-    view_.showPanel = options.panel;
+    view_.showPanel = options.panel.value_or(!recording());  // recordings: the scene alone
     view_.speed = options.speed;
     frame_ = runner_.frame();
     recordSpan_ = recordedFrameSpan(options.speed, options.courseTime, frame_.geometry->frameTime);
@@ -69,11 +70,23 @@ class Viewer {
   }
 
   void display();
-  void reshape(int w, int h) { viewport_ = {std::max(w, 1), std::max(h, 1)}; }
+  void reshape(int w, int h) {
+    viewport_ = {std::max(w, 1), std::max(h, 1)};
+    panel_.reshape(w, h);
+  }
   void key(unsigned char key);
   void mouse(int button, int state, int x, int y);
   void motion(int x, int y);
   void idle();
+  void passiveMotion(int x, int y) {
+    panel_.passiveMotion(x, y);
+    if (view_.showPanel) glutPostRedisplay();
+  }
+  void keyUp(unsigned char c, int x, int y) { panel_.keyUp(c, x, y); }
+  void special(int key, int x, int y, bool down) {
+    panel_.special(key, x, y, down);
+    glutPostRedisplay();
+  }
   int exitCode() const { return exitCode_; }
 
  private:
@@ -99,6 +112,7 @@ class Viewer {
 
   ViewerOptions options_;
   SimRunner runner_;
+  Panel panel_;
   Frame frame_;
   ViewerState view_;
   Viewport viewport_;
@@ -220,7 +234,10 @@ void Viewer::capture(const std::filesystem::path& path) {
 void Viewer::display() {
   if (recording()) waitForRecordedFrame();
   frame_ = runner_.frame();
-  drawnPublished_ = runner_.published();
+  if (const long published = runner_.published(); published != drawnPublished_) {
+    drawnPublished_ = published;
+    panel_.sample(seconds(Clock::now() - started_), frame_);
+  }
   takeNotices();
   if (frame_.divergence && !divergenceShown_) {
     divergenceShown_ = true;
@@ -228,6 +245,7 @@ void Viewer::display() {
   }
   if (!frame_.divergence) divergenceShown_ = false;
   drawFrame(view_, viewport_, scene(), overlay());
+  panel_.draw(frame_, view_, runner_);
   lastDraw_ = Clock::now();
 
   if (screenshotPending_) {
@@ -278,13 +296,16 @@ void Viewer::display() {
       } else {
         const double elapsed = seconds(now - started_);
         const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+        GLint samples = 0;
+        glGetIntegerv(GL_SAMPLES, &samples);
         std::printf(
-            "%d frames in %.3f s: %.1f frames/s (%s, %dx%d, %s, t = %.4g s, simulating %.3g s "
-            "per wall second%s; %s)\n",
+            "%d frames in %.3f s: %.1f frames/s (%s, %dx%d, %d samples, panel %s, %s, t = %.4g s, "
+            "simulating %.3g s per wall second%s; %s)\n",
             framesDrawn_, elapsed, framesDrawn_ / elapsed,
             view_.mode == DisplayMode::Shaded ? "shaded" : "wireframe", viewport_.width,
-            viewport_.height, std::string(integratorName(frame_.integrator)).c_str(),
-            frame_.state.t, frame_.state.t / elapsed, frame_.lagging ? ", lagging" : "",
+            viewport_.height, samples, view_.showPanel ? "open" : "hidden",
+            std::string(integratorName(frame_.integrator)).c_str(), frame_.state.t,
+            frame_.state.t / elapsed, frame_.lagging ? ", lagging" : "",
             renderer ? renderer : "unknown renderer");
       }
       return leave(0);
@@ -320,6 +341,7 @@ void Viewer::screenshot() {
 }
 
 void Viewer::key(unsigned char key) {
+  if (panel_.key(key, lastX_, lastY_)) return glutPostRedisplay();  // typing into the panel
   const KeyResult result = handleKey(view_, key);
   switch (result.command) {
     case Command::Quit:
@@ -385,6 +407,7 @@ void Viewer::key(unsigned char key) {
 }
 
 void Viewer::mouse(int button, int state, int x, int y) {
+  if (view_.showPanel && panel_.mouse(button, state, x, y)) return glutPostRedisplay();
   lastX_ = pressX_ = x;
   lastY_ = pressY_ = y;
   if (button == 3 || button == 4) {  // freeglut reports the wheel as buttons 3 and 4
@@ -418,6 +441,7 @@ void Viewer::mouse(int button, int state, int x, int y) {
 }
 
 void Viewer::motion(int x, int y) {
+  if (view_.showPanel && drag_ == Drag::None && panel_.motion(x, y)) return glutPostRedisplay();
   if (drag_ == Drag::Rotate) view_.camera.rotate(x - lastX_, y - lastY_);
   if (drag_ == Drag::Pan) view_.camera.pan(x - lastX_, y - lastY_, viewport_.height);
   lastX_ = x;
@@ -479,6 +503,10 @@ int runViewer(const ViewerOptions& options, World world) {
     glutKeyboardFunc([](unsigned char k, int, int) { active->key(k); });
     glutMouseFunc([](int b, int s, int x, int y) { active->mouse(b, s, x, y); });
     glutMotionFunc([](int x, int y) { active->motion(x, y); });
+    glutPassiveMotionFunc([](int x, int y) { active->passiveMotion(x, y); });
+    glutKeyboardUpFunc([](unsigned char k, int x, int y) { active->keyUp(k, x, y); });
+    glutSpecialFunc([](int k, int x, int y) { active->special(k, x, y, true); });
+    glutSpecialUpFunc([](int k, int x, int y) { active->special(k, x, y, false); });
     glutIdleFunc([] { active->idle(); });
     glutMainLoop();
     active = nullptr;

@@ -1,0 +1,54 @@
+#!/usr/bin/env python3
+"""The viewer's frame rates as a README table, from experiments/results/viewer_fps.json (written by
+scripts/bench-viewer.sh). --readme rewrites the table between <!-- viewer-speed:begin --> and
+<!-- viewer-speed:end --> in README.md; without it the table is printed."""
+import json
+import os
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+LABELS = {
+    "jello-rk4-shaded": "jello.w, rk4, shaded",
+    "jello-rk4-wireframe": "jello.w, rk4, wireframe",
+    "cube16-cvode-shaded": "cube16.w, cvode, shaded",
+}
+
+
+def table():
+    with open(os.path.join(ROOT, "experiments/results/viewer_fps.json")) as f:
+        data = json.load(f)
+    lines = ["| scene | frames/s drawn | simulated s per wall s | frames | multisampling | panel |",
+             "|---|---:|---:|---:|---:|---|"]
+    renderer = ""
+    for name, label in LABELS.items():
+        r = data["runs"][name]
+        renderer = r["renderer"]
+        lag = " (lagging)" if r["lagging"] else ""
+        lines.append(f"| {label} | {r['fps']:.0f} | {r['sim_rate']:.3g}{lag} | {r['frames']} | "
+                     f"{r['samples']}x | {r['panel']} |")
+    lines.append("")
+    lines.append(f"{r['width']}x{r['height']} under Xvfb with {renderer}; commit {data['commit']}; "
+                 "from `experiments/results/viewer_fps.json`.")
+    return "\n".join(lines)
+
+
+def main():
+    text = table()
+    if "--readme" not in sys.argv[1:]:
+        print(text)
+        return
+    path = os.path.join(ROOT, "README.md")
+    readme = open(path).read()
+    begin, end = "<!-- viewer-speed:begin -->", "<!-- viewer-speed:end -->"
+    if begin not in readme or end not in readme:
+        sys.exit(f"README.md has no {begin} ... {end} markers")
+    head, rest = readme.split(begin, 1)
+    _, tail = rest.split(end, 1)
+    tmp = path + ".tmp"
+    with open(tmp, "w") as f:
+        f.write(head + begin + "\n" + text + "\n" + end + tail)
+    os.replace(tmp, path)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,268 @@
+#include "viewer/panel.h"
+
+#include <GL/freeglut.h>
+#include <imgui.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "imgui_impl_glut.h"
+#include "imgui_impl_opengl2.h"
+#include "viewer/interaction.h"
+
+namespace jello::viewer {
+
+namespace {
+
+// The counter whose per-step growth is the solver's effort, by preference.
+constexpr std::array<const char*, 4> kEffortCounters{"newton_iterations", "projective_iterations",
+                                                     "rhs_evaluations", "cg_iterations"};
+
+std::optional<double> statistic(const Frame& frame, const char* name) {
+  for (const Statistic& s : frame.solver) {
+    if (s.name == name) return s.value;
+  }
+  return std::nullopt;
+}
+
+// A slider for a positive constant on a logarithmic scale; true when an edit was finished.
+bool logSlider(const char* label, float* value, float lo, float hi, const char* format) {
+  ImGui::SliderFloat(label, value, lo, hi, format, ImGuiSliderFlags_Logarithmic);
+  return ImGui::IsItemDeactivatedAfterEdit();
+}
+
+}  // namespace
+
+void PlotHistory::add(double wallTime, const Frame& frame) {
+  if (frame.steps < lastSteps_) clear();  // a reload: time starts over
+  const EnergyReport& e = frame.energy;
+  double effort = 0.0, effortStep = std::nan("");
+  effortName.clear();
+  for (const char* name : kEffortCounters) {
+    if (std::optional<double> v = statistic(frame, name)) {
+      effortName = name;
+      effort = *v;
+      break;
+    }
+  }
+  const long steps = frame.steps - std::max(lastSteps_, 0L);
+  const double perStep = lastSteps_ >= 0 && steps > 0 && effort >= lastEffort_
+                             ? (effort - lastEffort_) / static_cast<double>(steps)
+                             : 0.0;
+  lastSteps_ = frame.steps;
+  lastEffort_ = effort;
+  if (std::optional<double> h = statistic(frame, "last_step_s")) effortStep = *h;
+  const std::array<double, kCount> sample{e.kinetic,
+                                          e.spring,
+                                          e.contact,
+                                          e.field,
+                                          e.total(),
+                                          norm(frame.angularMomentum),
+                                          effortName.empty() ? 0.0 : perStep,
+                                          std::isnan(effortStep) ? 0.0 : effortStep};
+  wall.push_back(wallTime);
+  for (int i = 0; i < kCount; ++i) values[i].push_back(static_cast<float>(sample[i]));
+  while (!wall.empty() && wall.front() < wallTime - kWindow) {
+    wall.pop_front();
+    for (auto& v : values) v.pop_front();
+  }
+}
+
+void PlotHistory::clear() {
+  wall.clear();
+  for (auto& v : values) v.clear();
+  lastSteps_ = -1;
+  lastEffort_ = 0.0;
+}
+
+Panel::Panel() {
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini left in the user's directory
+  ImGui::StyleColorsDark();
+  ImGui::GetStyle().Alpha = 0.92f;
+  ImGui_ImplGLUT_Init();
+  ImGui_ImplOpenGL2_Init();
+}
+
+Panel::~Panel() {
+  ImGui_ImplOpenGL2_Shutdown();
+  ImGui_ImplGLUT_Shutdown();
+  ImGui::DestroyContext();
+}
+
+bool Panel::mouse(int button, int state, int x, int y) {
+  if (button == 3 || button == 4) {
+    if (state == GLUT_DOWN) ImGui_ImplGLUT_MouseWheelFunc(0, button == 3 ? 1 : -1, x, y);
+  } else {
+    ImGui_ImplGLUT_MouseFunc(button, state, x, y);
+  }
+  // A release always reaches the viewer too, so that its drags end.
+  return state == GLUT_DOWN && ImGui::GetIO().WantCaptureMouse;
+}
+
+bool Panel::motion(int x, int y) {
+  ImGui_ImplGLUT_MotionFunc(x, y);
+  return ImGui::GetIO().WantCaptureMouse && ImGui::IsAnyItemActive();
+}
+
+void Panel::passiveMotion(int x, int y) {
+  ImGui_ImplGLUT_MotionFunc(x, y);
+}
+
+bool Panel::key(unsigned char c, int x, int y) {
+  ImGui_ImplGLUT_KeyboardFunc(c, x, y);
+  return ImGui::GetIO().WantTextInput;
+}
+
+void Panel::keyUp(unsigned char c, int x, int y) {
+  ImGui_ImplGLUT_KeyboardUpFunc(c, x, y);
+}
+
+void Panel::special(int key, int x, int y, bool down) {
+  if (down) {
+    ImGui_ImplGLUT_SpecialFunc(key, x, y);
+  } else {
+    ImGui_ImplGLUT_SpecialUpFunc(key, x, y);
+  }
+}
+
+void Panel::reshape(int w, int h) {
+  ImGui_ImplGLUT_ReshapeFunc(w, h);
+}
+
+void Panel::syncFromWorld(const Frame& frame) {
+  const World& w = frame.geometry->world;
+  k_ = static_cast<float>(w.kElastic);
+  d_ = static_cast<float>(w.dElastic);
+  kCollision_ = static_cast<float>(w.kCollision);
+  dCollision_ = static_cast<float>(w.dCollision);
+  mass_ = static_cast<float>(w.mass);
+  dt_ = static_cast<float>(frame.dt);
+  if (w.plane) savedPlane_ = w.plane;
+  if (w.sphere) savedSphere_ = w.sphere;
+  plane_ = w.plane.has_value();
+  sphere_ = w.sphere.has_value();
+  generation_ = frame.generation;
+}
+
+void Panel::constants(const Frame& frame, SimRunner& runner) {
+  const auto edit = [&runner](std::function<void(World&)> change) {
+    runner.post([change = std::move(change)](ViewerSession& s) { s.editWorld(change); }, true);
+  };
+  if (logSlider("k (N/m)", &k_, 1.0f, 1e6f, "%.4g")) {
+    edit([k = double(k_)](World& w) { w.kElastic = k; });
+  }
+  if (logSlider("damping", &d_, 1e-4f, 100.0f, "%.3g")) {
+    edit([d = double(d_)](World& w) { w.dElastic = d; });
+  }
+  if (logSlider("k contact", &kCollision_, 1.0f, 1e6f, "%.4g")) {
+    edit([k = double(kCollision_)](World& w) { w.kCollision = k; });
+  }
+  if (logSlider("d contact", &dCollision_, 1e-4f, 100.0f, "%.3g")) {
+    edit([d = double(dCollision_)](World& w) { w.dCollision = d; });
+  }
+  if (logSlider("mass (kg)", &mass_, 1e-5f, 1.0f, "%.3g")) {
+    edit([m = double(mass_)](World& w) { w.mass = m; });
+  }
+  if (!frame.geometry->arrows.empty() || fieldScale_ != 1.0f) {
+    const float before = fieldScale_;
+    ImGui::SliderFloat("field x", &fieldScale_, 0.0f, 4.0f, "%.2f");
+    if (ImGui::IsItemDeactivatedAfterEdit() && before > 0.0f) {
+      edit([ratio = double(fieldScale_) / before](World& w) {
+        for (Vec3& f : w.field.forces) f = f * ratio;
+      });
+    } else if (before == 0.0f) {
+      fieldScale_ = 0.0f;  // a field scaled to nothing cannot be scaled back
+    }
+  }
+  if (savedPlane_ && ImGui::Checkbox("inclined plane", &plane_)) {
+    edit([p = plane_ ? savedPlane_ : std::nullopt](World& w) { w.plane = p; });
+  }
+  if (savedSphere_ && ImGui::Checkbox("sphere", &sphere_)) {
+    edit([p = sphere_ ? savedSphere_ : std::nullopt](World& w) { w.sphere = p; });
+  }
+}
+
+void Panel::plots(const Frame& frame) {
+  const auto plot = [&](int series, const char* overlay) {
+    const auto& v = history_.values[series];
+    if (v.empty()) return;
+    std::vector<float> data(v.begin(), v.end());
+    const auto [lo, hi] = std::minmax_element(data.begin(), data.end());
+    char label[96];
+    std::snprintf(label, sizeof label, "%s %.4g", overlay, double(data.back()));
+    ImGui::PlotLines(PlotHistory::kNames[series], data.data(), int(data.size()), 0, label, *lo,
+                     *hi > *lo ? *hi : *lo + 1e-6f, ImVec2(130.0f, 32.0f));
+  };
+  for (int s : {PlotHistory::Total, PlotHistory::Kinetic, PlotHistory::Spring, PlotHistory::Contact,
+                PlotHistory::Field, PlotHistory::AngularMomentum}) {
+    plot(s, "");
+  }
+  if (!history_.effortName.empty()) plot(PlotHistory::Effort, history_.effortName.c_str());
+  if (statistic(frame, "last_step_s")) plot(PlotHistory::StepSize, "");
+}
+
+void Panel::draw(const Frame& frame, ViewerState& view, SimRunner& runner) {
+  ImGui_ImplOpenGL2_NewFrame();
+  ImGui_ImplGLUT_NewFrame();
+  if (frame.generation != generation_) syncFromWorld(frame);
+  if (view.showPanel) {
+    // A narrow column at the right, below the heads-up: the cube stays in view at 640x480.
+    ImGui::SetNextWindowPos(ImVec2(ImGui::GetIO().DisplaySize.x - 258.0f, 44.0f),
+                            ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowSize(ImVec2(250.0f, 0.0f), ImGuiCond_FirstUseEver);
+    ImGui::SetNextWindowBgAlpha(0.75f);
+    ImGui::Begin("panel (m hides)", &view.showPanel);
+    ImGui::PushItemWidth(130.0f);
+    // Integrator and time step.
+    const auto kinds = allIntegrators();
+    if (ImGui::BeginCombo("integrator", std::string(integratorName(frame.integrator)).c_str())) {
+      for (IntegratorKind kind : kinds) {
+        const bool selected = kind == frame.integrator;
+        if (ImGui::Selectable(std::string(integratorName(kind)).c_str(), selected) && !selected &&
+            !frame.divergence) {
+          runner.post([kind](ViewerSession& s) { s.simulation().setIntegrator(kind); }, true);
+        }
+      }
+      ImGui::EndCombo();
+    }
+    if (std::abs(dt_ - float(frame.dt)) > 1e-9f * float(frame.dt) && !ImGui::IsAnyItemActive())
+      dt_ = static_cast<float>(frame.dt);
+    if (logSlider("dt (s)", &dt_, 1e-6f, 0.1f, "%.3g")) {
+      runner.post([dt = double(dt_)](ViewerSession& s) { s.setTimeStep(dt); }, true);
+    }
+    float speed = static_cast<float>(view.speed);
+    if (ImGui::SliderFloat("speed", &speed, float(kMinSpeed), float(kMaxSpeed), "%.4gx",
+                           ImGuiSliderFlags_Logarithmic)) {
+      view.speed = speed;
+      runner.setSpeed(view.speed);
+    }
+    ImGui::Text("t %.3f s  %ld steps", frame.state.t, frame.steps);
+    ImGui::Text("%.3g simulated s per wall s%s", frame.simRate, frame.lagging ? " (behind)" : "");
+    if (ImGui::CollapsingHeader("world")) constants(frame, runner);
+    if (ImGui::CollapsingHeader("pull")) {
+      ImGui::Checkbox("pull mode (g)", &view.pullMode);
+      ImGui::SliderInt("radius ([ ])", &view.pullRadius, 0, int(pullRadii().size()) - 1,
+                       pullRadii()[std::size_t(view.pullRadius)] == 0.0        ? "one point"
+                       : std::isinf(pullRadii()[std::size_t(view.pullRadius)]) ? "whole cube"
+                                                                               : "%d");
+      if (logSlider("stiffness x k", &pullScale_, 0.01f, 100.0f, "%.3g")) {
+        runner.post(
+            [s = double(pullScale_)](ViewerSession& session) { session.setPullStiffnessScale(s); });
+      }
+    }
+    if (ImGui::CollapsingHeader("plots", ImGuiTreeNodeFlags_DefaultOpen)) plots(frame);
+    if (ImGui::CollapsingHeader("solver statistics")) {
+      for (const Statistic& s : frame.solver) ImGui::Text("%-28s %.6g", s.name.c_str(), s.value);
+      if (frame.solver.empty()) ImGui::TextUnformatted("(none: an explicit integrator)");
+    }
+    ImGui::PopItemWidth();
+    ImGui::End();
+  }
+  ImGui::Render();
+  ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData());
+}
+
+}  // namespace jello::viewer

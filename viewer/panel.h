@@ -1,0 +1,77 @@
+// The live panel (Dear ImGui over GLUT and OpenGL 2): the integrator and its time step, the
+// playback speed, the world's constants, the obstacles, the pull, live plots of the energies,
+// the angular momentum and the solver's effort over the last seconds, and the solver's counters.
+// Edits go to the simulation thread as commands; nothing here waits for a step.
+#pragma once
+
+#include <array>
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "viewer/sim_runner.h"
+#include "viewer/viewer_state.h"
+
+namespace jello::viewer {
+
+// The plotted quantities over a sliding window of simulated time, one sample per new frame.
+struct PlotHistory {
+  static constexpr double kWindow = 10.0;  // wall seconds kept
+  enum Series { Kinetic, Spring, Contact, Field, Total, AngularMomentum, Effort, StepSize, kCount };
+  static constexpr std::array<const char*, kCount> kNames{
+      "kinetic (J)", "spring (J)",     "contact (J)",          "field (J)",
+      "total (J)",   "|L| (kg m^2/s)", "solver effort / step", "CVODE step (s)"};
+  std::deque<double> wall;
+  std::array<std::deque<float>, kCount> values;
+  std::string effortName;  // which counter the effort is of ("newton_iterations", ...)
+
+  // Adds a sample for `frame` (once per published frame), dropping samples older than kWindow.
+  void add(double wallTime, const Frame& frame);
+  void clear();
+
+ private:
+  long lastSteps_ = -1;
+  double lastEffort_ = 0.0;
+};
+
+class Panel {
+ public:
+  // After the GL window exists.
+  Panel();
+  ~Panel();
+  Panel(const Panel&) = delete;
+  Panel& operator=(const Panel&) = delete;
+
+  // Input, forwarded first: true when the panel takes it (the pointer is over it, or a text
+  // field has the keyboard).
+  bool mouse(int button, int state, int x, int y);
+  bool motion(int x, int y);
+  void passiveMotion(int x, int y);
+  bool key(unsigned char c, int x, int y);
+  void keyUp(unsigned char c, int x, int y);
+  void special(int key, int x, int y, bool down);
+  void reshape(int w, int h);
+
+  // Records a sample of a newly published frame.
+  void sample(double wallTime, const Frame& frame) { history_.add(wallTime, frame); }
+  // Draws the panel (when view.showPanel) over the frame just drawn; edits go to `runner`.
+  void draw(const Frame& frame, ViewerState& view, SimRunner& runner);
+
+ private:
+  void syncFromWorld(const Frame& frame);
+  void constants(const Frame& frame, SimRunner& runner);
+  void plots(const Frame& frame);
+
+  PlotHistory history_;
+  long generation_ = -1;
+  // Slider values, taken from the world when the scene is replaced.
+  float k_ = 0, d_ = 0, kCollision_ = 0, dCollision_ = 0, mass_ = 0, fieldScale_ = 1;
+  float dt_ = 0;
+  float pullScale_ = 1;
+  std::optional<Plane> savedPlane_;
+  std::optional<Sphere> savedSphere_;
+  bool plane_ = false, sphere_ = false;
+};
+
+}  // namespace jello::viewer
