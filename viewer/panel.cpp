@@ -2,13 +2,13 @@
 
 #include <GL/freeglut.h>
 #include <imgui.h>
+#include <imgui_impl_glut.h>
+#include <imgui_impl_opengl2.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-#include "imgui_impl_glut.h"
-#include "imgui_impl_opengl2.h"
 #include "viewer/interaction.h"
 
 namespace jello::viewer {
