@@ -205,9 +205,24 @@ void Panel::plots(const Frame& frame) {
 }
 
 void Panel::draw(const Frame& frame, ViewerState& view, SimRunner& runner) {
+  if (frame.generation != generation_) syncFromWorld(frame);
+  if (!warmedUp_) {
+    // ImGui sizes an auto-fitting window in its first frame and draws it from the second: a
+    // pass that is not rendered, so that the first drawn (or recorded) frame has the panel.
+    ImGui_ImplOpenGL2_NewFrame();
+    ImGui_ImplGLUT_NewFrame();
+    build(frame, view, runner);
+    ImGui::EndFrame();
+    warmedUp_ = true;
+  }
   ImGui_ImplOpenGL2_NewFrame();
   ImGui_ImplGLUT_NewFrame();
-  if (frame.generation != generation_) syncFromWorld(frame);
+  build(frame, view, runner);
+  ImGui::Render();
+  ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData());
+}
+
+void Panel::build(const Frame& frame, ViewerState& view, SimRunner& runner) {
   if (view.showPanel) {
     // A narrow column at the right, below the heads-up: the cube stays in view at 640x480.
     ImGui::SetNextWindowPos(ImVec2(ImGui::GetIO().DisplaySize.x - 258.0f, 44.0f),
@@ -261,8 +276,6 @@ void Panel::draw(const Frame& frame, ViewerState& view, SimRunner& runner) {
     ImGui::PopItemWidth();
     ImGui::End();
   }
-  ImGui::Render();
-  ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData());
 }
 
 }  // namespace jello::viewer

@@ -59,6 +59,7 @@ class Panel {
   void draw(const Frame& frame, ViewerState& view, SimRunner& runner);
 
  private:
+  void build(const Frame& frame, ViewerState& view, SimRunner& runner);
   void syncFromWorld(const Frame& frame);
   void constants(const Frame& frame, SimRunner& runner);
   void plots(const Frame& frame);
@@ -72,6 +73,7 @@ class Panel {
   std::optional<Plane> savedPlane_;
   std::optional<Sphere> savedSphere_;
   bool plane_ = false, sphere_ = false;
+  bool warmedUp_ = false;
 };
 
 }  // namespace jello::viewer
