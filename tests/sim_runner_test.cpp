@@ -13,6 +13,7 @@
 
 #include "src/world_reader.h"
 #include "tests/test_support.h"
+#include "viewer/runner_group.h"
 #include "viewer/viewer_state.h"
 
 namespace jello::viewer {
@@ -170,6 +171,64 @@ TEST(SimRunner, ACommandThatFailsBecomesAnAlarmNotAStop) {
   ASSERT_EQ(notices.size(), 1u);
   EXPECT_EQ(notices[0].text, "disk full");
   EXPECT_TRUE(notices[0].alarm);
+}
+
+TEST(RunnerGroup, CompareModeStepsEveryIntegratorToTheSameSimulatedTime) {
+  // Explicit Euler blows up on skewedCorner.w at this dt; RK4 and backward Euler do not. The
+  // group's clock moves on only when every live member has arrived, and the diverged one stops
+  // holding it back.
+  World w = test::loadWorld("skewedCorner.w");
+  SimRunner::Options o;
+  o.speed = 1.0;
+  SceneSource src = source("skewedCorner.w");
+  src.dt = 0.001;
+  RunnerGroup group(src, w, {IntegratorKind::RK4, IntegratorKind::Implicit, IntegratorKind::Euler},
+                    o);
+  ASSERT_EQ(group.size(), 3u);
+  double wall = 0.0;
+  group.tick(wall);
+  for (int i = 0; i < 10; ++i) {
+    wall += 0.05;
+    group.tick(wall);
+    const double target = group.target();
+    for (std::size_t m = 0; m < group.size(); ++m) {
+      if (!group[m].waitFor(target, 60.0)) {
+        ASSERT_TRUE(group[m].frame().divergence) << m;
+      }
+    }
+    ASSERT_TRUE(group.allReached());
+    const double t0 = group[0].frame().state.t;
+    EXPECT_NEAR(group[1].frame().state.t, t0, 1e-9) << "at " << target;  // the same instant
+    EXPECT_NEAR(t0, target, 0.002 + 1e-9);                               // to one step
+  }
+  EXPECT_NEAR(group.target(), 0.5, 1e-9);  // 10 ticks of 50 ms at speed 1
+  EXPECT_TRUE(group[2].frame().divergence.has_value());
+  EXPECT_FALSE(group[0].frame().divergence.has_value());
+  EXPECT_EQ(group[1].frame().integrator, IntegratorKind::Implicit);
+
+  group.setPaused(true);  // paused: the clock stands
+  group.tick(wall + 1.0);
+  EXPECT_NEAR(group.target(), 0.5, 1e-9);
+  group.advanceBy(0.1);  // `.`: one shared step
+  EXPECT_NEAR(group.target(), 0.6, 1e-9);
+}
+
+TEST(Panes, SplitTheWindowAndMapPixelsBackToTheirPane) {
+  const Viewport window{800, 600};
+  const std::vector<Pane> two = paneLayout(2, window);
+  ASSERT_EQ(two.size(), 2u);
+  EXPECT_EQ(two[1].x, 400);
+  EXPECT_EQ(two[1].size.height, 600);
+  const std::vector<Pane> four = paneLayout(4, window);
+  EXPECT_EQ(four[0].y, 300);  // the first row is the top one (GL's y up)
+  EXPECT_EQ(four[3].x, 400);
+  EXPECT_EQ(four[3].y, 0);
+  const std::optional<PanePixel> at = paneAt(four, window, 450.0, 310.0);  // GLUT: y down
+  ASSERT_TRUE(at.has_value());
+  EXPECT_EQ(at->pane, 3);
+  EXPECT_DOUBLE_EQ(at->x, 50.0);
+  EXPECT_DOUBLE_EQ(at->y, 10.0);
+  EXPECT_FALSE(paneAt(four, window, 900.0, 10.0).has_value());
 }
 
 TEST(ViewerSession, SavingWritesAWorldThatReloadsToTheSameState) {

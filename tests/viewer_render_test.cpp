@@ -179,6 +179,30 @@ TEST_F(Frames, ThePanelIsDrawnAtTheRightAndLeavesTheRestAlone) {
   EXPECT_LT(outside / nOut, 1.0);
 }
 
+TEST(Recording, CompareModeDrawsEachIntegratorInItsOwnPane) {
+  test::TempDir dir;
+  const auto out = dir.path() / "compare";
+  const Outcome r = run(headless(world("jello.w") + " --no-hud --compare rk4,implicit --frames 1" +
+                                 " --record " + out.string()));
+  ASSERT_EQ(r.code, 0) << r.output;
+  const Image image = readImage(out / "000.jpg");
+  // Two panes of 320x480 (less a one-pixel gutter), the same camera: the cube's centroid
+  // projects to the same place in each, and both are jello red there.
+  const State s = initialState(test::loadWorld("jello.w"));
+  Vec3 centroid;
+  for (int p = 0; p < s.numPoints(); ++p) centroid += s.position(p) * (1.0 / s.numPoints());
+  const auto c = project(Camera{}, Viewport{319, 479}, centroid);
+  ASSERT_TRUE(c.has_value());
+  for (int pane = 0; pane < 2; ++pane) {
+    const Rgb centre = pixel(image, pane * 320 + int(c->x), 1 + int(c->y));
+    EXPECT_GT(centre.r, 80) << "pane " << pane;
+    EXPECT_GT(centre.r, 2 * centre.g) << "pane " << pane;
+  }
+  // Mid-window, on the gutter's column: the panes' split, not a stretched single view.
+  const Rgb gutter = pixel(image, 319, 470);
+  EXPECT_LT(gutter.r + gutter.g + gutter.b, 3 * 30);
+}
+
 TEST(Recording, ThirtyFramesAreThirtyValidChangingJpegs) {
   test::TempDir dir;
   const auto out = dir.path() / "frames";

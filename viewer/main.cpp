@@ -1,5 +1,5 @@
 // jello: the interactive viewer.
-//   jello [WORLD] [--integrator NAME] [--dt S] [--speed X | --course-time]
+//   jello [WORLD] [--integrator NAME | --compare A,B,...] [--dt S] [--speed X | --course-time]
 //         [--record DIR --frames N] [--size WxH]
 // Exit codes: 0 done, 1 runtime failure (no display, a frame not written), 2 bad arguments or
 // world file, 3 the simulation diverged while recording or benchmarking.
@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <iostream>
 #include <regex>
+#include <sstream>
 
 #include "solvers/solver_threads.h"
 #include "src/finite_options.h"
@@ -53,6 +54,11 @@ int main(int argc, char** argv) {
       ->check(jello::cli::range(1, jello::viewer::kMaxRecordedFrames))
       ->needs(record);
   record->needs("--frames");
+  std::string compare;
+  app.add_option("--compare", compare,
+                 "Run these integrators (2-6, comma-separated, e.g. rk4,implicit) side by side in "
+                 "split panes, at one shared simulated time")
+      ->excludes("--integrator");
   app.add_option("--size", size, "Window size WxH in pixels")->capture_default_str();
   app.add_option("--speed", opt.speed,
                  "Playback speed: simulated seconds per wall second (also of a recording: "
@@ -108,6 +114,21 @@ int main(int argc, char** argv) {
     }
   }
   if (panel || noPanel) opt.panel = panel;
+  if (!compare.empty()) {
+    std::stringstream list(compare);
+    for (std::string name; std::getline(list, name, ',');) {
+      const std::optional<jello::IntegratorKind> kind = jello::parseIntegratorName(name);
+      if (!kind) {
+        return usageError("--compare: unknown integrator '" + name +
+                          "' (known: " + jello::integratorNameList() + ")");
+      }
+      opt.compare.push_back(*kind);
+    }
+    if (opt.compare.size() < 2 || opt.compare.size() > 6) {
+      return usageError("--compare wants 2 to 6 integrators, e.g. rk4,implicit, not '" + compare +
+                        "'");
+    }
+  }
   opt.source.world = world;
   // With --integrator, a file naming an integrator we do not have still loads (with a warning).
   opt.source.limits.acceptUnknownIntegrator = opt.source.integrator.has_value();

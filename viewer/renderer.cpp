@@ -150,8 +150,11 @@ void drawArrows(const std::vector<Arrow>& arrows) {
   glEnd();
 }
 
+// The drawn pane's lower-left corner in the window (glWindowPos is in window coordinates).
+int paneX = 0, paneY = 0;
+
 void drawText(int x, int y, const std::string& text) {
-  glWindowPos2i(x, y);
+  glWindowPos2i(paneX + x, paneY + y);
   glutBitmapString(GLUT_BITMAP_8_BY_13, reinterpret_cast<const unsigned char*>(text.c_str()));
 }
 
@@ -288,8 +291,12 @@ void initRenderer() {
 }
 
 void drawFrame(const ViewerState& view, const Viewport& viewport, const Scene& scene,
-               const Overlay& overlay) {
-  glViewport(0, 0, viewport.width, viewport.height);
+               const Overlay& overlay, int x0, int y0) {
+  paneX = x0;
+  paneY = y0;
+  glViewport(x0, y0, viewport.width, viewport.height);
+  glScissor(x0, y0, viewport.width, viewport.height);
+  glEnable(GL_SCISSOR_TEST);
   glClearColor(kBackground[0], kBackground[1], kBackground[2], 1.0f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glMatrixMode(GL_PROJECTION);
@@ -316,6 +323,7 @@ void drawFrame(const ViewerState& view, const Viewport& viewport, const Scene& s
   if (scene.push) drawPush(view, scene);
   if (scene.world->plane) drawPlane(*scene.world->plane);  // blended: last
   drawOverlay(viewport, view, overlay);
+  glDisable(GL_SCISSOR_TEST);
 }
 
 std::vector<std::uint8_t> readBackBuffer(const Viewport& viewport) {

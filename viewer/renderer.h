@@ -40,8 +40,10 @@ struct Overlay {
 
 // Once, after the window exists: depth test, lights, materials.
 void initRenderer();
+// Draws into the pane of size `viewport` whose lower-left corner is (x0, y0) in the window
+// (GL's window coordinates: y up); the rest of the window is left alone.
 void drawFrame(const ViewerState& view, const Viewport& viewport, const Scene& scene,
-               const Overlay& overlay);
+               const Overlay& overlay, int x0 = 0, int y0 = 0);
 
 // The back buffer's pixels, bottom row first (GL order), RGB.
 std::vector<std::uint8_t> readBackBuffer(const Viewport& viewport);

@@ -15,6 +15,7 @@
 #include "viewer/interaction.h"
 #include "viewer/panel.h"
 #include "viewer/renderer.h"
+#include "viewer/runner_group.h"
 #include "viewer/sim_runner.h"
 #include "viewer/viewer_state.h"
 
@@ -56,17 +57,23 @@ SimRunner::Options runnerOptions(const ViewerOptions& options) {
 
 class Viewer {
  public:
-  Viewer(const ViewerOptions& options, World world)
-      : options_(options),
-        runner_(options.source, std::move(world), runnerOptions(options)),
-        viewport_(options.size) {
+  Viewer(const ViewerOptions& options, World world) : options_(options), viewport_(options.size) {
+    if (options.compare.empty()) {
+      single_ =
+          std::make_unique<SimRunner>(options.source, std::move(world), runnerOptions(options));
+    } else {
+      group_ = std::make_unique<RunnerGroup>(options.source, world, options.compare,
+                                             runnerOptions(options));
+    }
     view_.mode = options.wireframe ? DisplayMode::Wireframe : DisplayMode::Shaded;
     view_.showHud = options.hud;
     view_.showPanel = options.panel.value_or(!recording());  // recordings: the scene alone
     view_.speed = options.speed;
-    frame_ = runner_.frame();
-    recordSpan_ = recordedFrameSpan(options.speed, options.courseTime, frame_.geometry->frameTime);
-    recordStart_ = frame_.state.t;
+    frames_.resize(group_ ? group_->size() : 1);
+    for (std::size_t i = 0; i < frames_.size(); ++i) frames_[i] = runner(i).frame();
+    recordSpan_ =
+        recordedFrameSpan(options.speed, options.courseTime, primary().geometry->frameTime);
+    recordStart_ = primary().state.t;
   }
 
   void display();
@@ -100,9 +107,9 @@ class Viewer {
     messageTime_ = Clock::now();
   }
   void takeNotices();
-  Overlay overlay() const;
-  std::string hudLine() const;
-  Scene scene() const;
+  Overlay overlay(std::size_t pane) const;
+  std::string hudLine(std::size_t pane) const;
+  Scene scene(std::size_t pane) const;
   void leave(int code) {
     exitCode_ = code;
     glutLeaveMainLoop();
@@ -111,9 +118,30 @@ class Viewer {
   std::string restartHint() const;
 
   ViewerOptions options_;
-  SimRunner runner_;
+  // The simulation: one runner, or one per integrator in compare mode.
+  SimRunner& runner(std::size_t i = 0) { return single_ ? *single_ : (*group_)[i]; }
+  std::size_t runnerCount() const { return group_ ? group_->size() : 1; }
+  template <class F>
+  void forEachRunner(F f) {
+    for (std::size_t i = 0; i < runnerCount(); ++i) f(runner(i));
+  }
+  void postAll(const std::function<void(ViewerSession&)>& command, bool urgent = false) {
+    forEachRunner([&](SimRunner& r) { r.post(command, urgent); });
+  }
+  double latestTime() const {
+    double t = frames_.front().state.t;
+    for (const Frame& f : frames_) t = std::max(t, f.state.t);
+    return t;
+  }
+  void drawPanes();
+
+  std::unique_ptr<SimRunner> single_;
+  std::unique_ptr<RunnerGroup> group_;
   Panel panel_;
-  Frame frame_;
+  std::vector<Frame> frames_;
+  // The first (or only) runner's frame: the heads-up, the panel and picking use it.
+  Frame& primary() { return frames_.front(); }
+  const Frame& primary() const { return frames_.front(); }
   ViewerState view_;
   Viewport viewport_;
   std::string message_;
@@ -128,7 +156,9 @@ class Viewer {
 
   enum class Drag { None, Rotate, Pan, Push, Pull } drag_ = Drag::None;
   int lastX_ = 0, lastY_ = 0, pressX_ = 0, pressY_ = 0;
-  Vec3 anchor_;  // the picked point where the pull began: the drag plane goes through it
+  Vec3 anchor_;        // the picked point where the pull began: the drag plane goes through it
+  Viewport dragPane_;  // the pane the pull was picked in
+  double dragOffsetX_ = 0, dragOffsetY_ = 0;  // its top-left corner in the window
   Vec3 pushAccel_;
 
   Clock::time_point started_ = Clock::now(), rateWindow_ = Clock::now(), lastDraw_ = Clock::now();
@@ -137,27 +167,30 @@ class Viewer {
 };
 
 std::string Viewer::restartHint() const {
+  if (group_) return " - press r to reload the world for every pane";
   return " - press r to reload the world (then 1-" + std::to_string(allIntegrators().size() % 10) +
          " picks an integrator, - a smaller time step)";
 }
 
-std::string Viewer::hudLine() const {
+std::string Viewer::hudLine(std::size_t pane) const {
+  const Frame& f = frames_[pane];
   std::ostringstream os;
-  os << integratorName(frame_.integrator) << "  dt " << format("%.3g", frame_.dt) << " s  t "
-     << format("%.3f", frame_.state.t) << " s  ";
+  os << integratorName(f.integrator) << "  dt " << format("%.3g", f.dt) << " s  t "
+     << format("%.3f", f.state.t) << " s  ";
   if (options_.courseTime) {
     os << "course time (n*dt per frame)";
   } else {
-    os << "speed " << format("%.4g", frame_.speed) << "x";
+    os << "speed " << format("%.4g", f.speed) << "x";
   }
-  os << "  " << format("%.0f", fps_) << " fps  E " << format("%.4g", frame_.energy.total()) << " J";
-  const bool behind = frame_.lagging && !frame_.paused && !frame_.divergence;
-  const bool slow = !options_.courseTime && !frame_.paused && frame_.simRate < 0.9 * frame_.speed &&
-                    !frame_.divergence;
+  os << "  " << format("%.0f", fps_) << " fps  E " << format("%.4g", f.energy.total()) << " J";
+  const bool behind = f.lagging && !f.paused && !f.divergence;
+  const bool slow = !options_.courseTime && !recording() && !f.paused &&
+                    f.simRate < 0.9 * f.speed && !f.divergence;
   if (behind || slow) {
-    os << "\nbehind: simulating " << format("%.3g", frame_.simRate)
-       << " s per wall second (speed asks " << format("%.4g", frame_.speed) << ")";
+    os << "\nbehind: simulating " << format("%.3g", f.simRate) << " s per wall second (speed asks "
+       << format("%.4g", f.speed) << ")";
   }
+  if (pane > 0) return os.str();  // the first pane says the rest
   if (view_.paused || view_.pullMode || drag_ == Drag::Pull) os << '\n';
   if (view_.paused) os << "[paused]  ";
   if (view_.pullMode || drag_ == Drag::Pull) {
@@ -167,15 +200,16 @@ std::string Viewer::hudLine() const {
   return os.str();
 }
 
-Overlay Viewer::overlay() const {
+Overlay Viewer::overlay(std::size_t pane) const {
   Overlay o;
-  o.hud = hudLine();
-  if (view_.showHelp) o.help = "Keys and mouse (? closes):\n" + keyTable();
-  if (frame_.divergence) {  // stays until the scene is restarted
-    o.message = *frame_.divergence + restartHint();
+  o.hud = hudLine(pane);
+  if (view_.showHelp && pane == 0) o.help = "Keys and mouse (? closes):\n" + keyTable();
+  if (frames_[pane].divergence) {  // stays until the scene is restarted
+    o.message = *frames_[pane].divergence + restartHint();
     o.alarm = true;
     return o;
   }
+  if (pane > 0) return o;
   o.message = message_;
   o.alarm = alarm_;
   const double age = seconds(Clock::now() - messageTime_);
@@ -185,22 +219,23 @@ Overlay Viewer::overlay() const {
   return o;
 }
 
-Scene Viewer::scene() const {
-  const SceneGeometry& g = *frame_.geometry;
+Scene Viewer::scene(std::size_t pane) const {
+  const Frame& f = frames_[pane];
+  const SceneGeometry& g = *f.geometry;
   Scene s;
   s.world = &g.world;
-  s.state = &frame_.state;
+  s.state = &f.state;
   s.mesh = &g.mesh;
   s.springs = &g.springs;
   s.arrows = &g.arrows;
-  if (frame_.pull) {
-    s.pull = std::pair(frame_.state.position(frame_.pull->first), frame_.pull->second);
+  if (f.pull) {
+    s.pull = std::pair(f.state.position(f.pull->first), f.pull->second);
     s.pullRadius = pullRadius();
   }
   if (drag_ == Drag::Push && norm(pushAccel_) > 0.0) {
     Vec3 centre;
-    const int n = frame_.state.numPoints();
-    for (int p = 0; p < n; ++p) centre = centre + frame_.state.position(p);
+    const int n = f.state.numPoints();
+    for (int p = 0; p < n; ++p) centre = centre + f.state.position(p);
     centre = centre * (1.0 / n);
     s.push = std::pair(centre, centre + pushAccel_ * 0.1);  // 10 cm per m/s^2
   }
@@ -208,23 +243,45 @@ Scene Viewer::scene() const {
 }
 
 void Viewer::takeNotices() {
-  for (Notice& n : runner_.takeNotices()) {
-    if (n.alarm) std::cerr << "jello: " << n.text << '\n';
-    notify(std::move(n.text), n.alarm);
-  }
+  forEachRunner([&](SimRunner& r) {
+    for (Notice& n : r.takeNotices()) {
+      if (n.alarm) std::cerr << "jello: " << n.text << '\n';
+      notify(std::move(n.text), n.alarm);
+    }
+  });
 }
 
 void Viewer::waitForRecordedFrame() {
   // Frame i shows simulated time t0 + i * span: 300 frames play 20 s of animation at speed 1.
   const double goal = recordStart_ + framesDrawn_ * recordSpan_;
-  runner_.setTarget(goal);
-  while (!runner_.waitFor(goal, 0.5)) {
-    if (runner_.frame().divergence) return;
-    if (::isatty(STDERR_FILENO)) {
-      std::fprintf(stderr, "\rjello: frame %d of %d (simulating t = %.4g s)", framesDrawn_ + 1,
-                   options_.frames, runner_.frame().state.t);
+  if (group_) group_->setTarget(goal);
+  forEachRunner([&](SimRunner& r) {
+    r.setTarget(goal);
+    while (!r.waitFor(goal, 0.5)) {
+      if (r.frame().divergence) return;
+      if (::isatty(STDERR_FILENO)) {
+        std::fprintf(stderr, "\rjello: frame %d of %d (simulating t = %.4g s)", framesDrawn_ + 1,
+                     options_.frames, r.frame().state.t);
+      }
     }
+  });
+}
+
+void Viewer::drawPanes() {
+  if (!group_) {
+    drawFrame(view_, viewport_, scene(0), overlay(0));
+    return;
   }
+  const std::vector<Pane> panes = paneLayout(int(group_->size()), viewport_);
+  glClearColor(0.0f, 0.0f, 0.0f, 1.0f);  // the gaps between panes
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  for (std::size_t i = 0; i < panes.size(); ++i) {
+    // A one-pixel gutter between panes.
+    const Viewport inner{std::max(1, panes[i].size.width - 1),
+                         std::max(1, panes[i].size.height - 1)};
+    drawFrame(view_, inner, scene(i), overlay(i), panes[i].x, panes[i].y);
+  }
+  glViewport(0, 0, viewport_.width, viewport_.height);
 }
 
 void Viewer::capture(const std::filesystem::path& path) {
@@ -233,19 +290,30 @@ void Viewer::capture(const std::filesystem::path& path) {
 
 void Viewer::display() {
   if (recording()) waitForRecordedFrame();
-  frame_ = runner_.frame();
-  if (const long published = runner_.published(); published != drawnPublished_) {
+  if (group_ && !recording()) {
+    if (options_.courseTime) {
+      if (!view_.paused && group_->allReached()) group_->advanceBy(primary().geometry->frameTime);
+    } else {
+      group_->tick(seconds(Clock::now() - started_));
+    }
+  }
+  for (std::size_t i = 0; i < frames_.size(); ++i) frames_[i] = runner(i).frame();
+  if (const long published = runner().published(); published != drawnPublished_) {
     drawnPublished_ = published;
-    panel_.sample(seconds(Clock::now() - started_), frame_);
+    panel_.sample(seconds(Clock::now() - started_), primary());
   }
   takeNotices();
-  if (frame_.divergence && !divergenceShown_) {
+  // One integrator diverging pauses a single view; in compare mode the others go on.
+  const bool stopped = group_ ? std::all_of(frames_.begin(), frames_.end(),
+                                            [](const Frame& f) { return f.divergence; })
+                              : primary().divergence.has_value();
+  if (stopped && !divergenceShown_) {
     divergenceShown_ = true;
     view_.paused = true;
   }
-  if (!frame_.divergence) divergenceShown_ = false;
-  drawFrame(view_, viewport_, scene(), overlay());
-  panel_.draw(frame_, view_, runner_);
+  if (!stopped) divergenceShown_ = false;
+  drawPanes();
+  if (!group_) panel_.draw(primary(), view_, runner());
   lastDraw_ = Clock::now();
 
   if (screenshotPending_) {
@@ -268,7 +336,9 @@ void Viewer::display() {
   }
   ++framesDrawn_;
   ++windowFrames_;
-  if (options_.courseTime && !view_.paused) runner_.advanceTarget(frame_.geometry->frameTime);
+  if (options_.courseTime && !view_.paused && !group_) {
+    runner().advanceTarget(primary().geometry->frameTime);
+  }
 
   const Clock::time_point now = Clock::now();
   if (const double span = seconds(now - rateWindow_); span >= 0.5) {
@@ -281,16 +351,16 @@ void Viewer::display() {
   if (target > 0) {
     if (recording() && ::isatty(STDERR_FILENO)) {
       std::fprintf(stderr, "\rjello: frame %d of %d (t = %.4g s)          ", framesDrawn_, target,
-                   frame_.state.t);
+                   primary().state.t);
     }
-    if (frame_.divergence) return leave(3);
+    if (stopped) return leave(3);
     if (framesDrawn_ >= target) {
       if (recording()) {
         if (::isatty(STDERR_FILENO)) std::fprintf(stderr, "\n");
         std::printf(
             "jello: wrote %d frames to %s: simulated t = %.4g .. %.4g s (%s, %.4g s per frame; "
             "%.4g s of animation at 15 frames/s)\n",
-            framesDrawn_, options_.recordDir.c_str(), recordStart_, frame_.state.t,
+            framesDrawn_, options_.recordDir.c_str(), recordStart_, latestTime(),
             options_.courseTime ? "course time" : ("speed " + format("%.4g", view_.speed)).c_str(),
             recordSpan_, framesDrawn_ / kRecordedFramesPerSecond);
       } else {
@@ -304,8 +374,8 @@ void Viewer::display() {
             framesDrawn_, elapsed, framesDrawn_ / elapsed,
             view_.mode == DisplayMode::Shaded ? "shaded" : "wireframe", viewport_.width,
             viewport_.height, samples, view_.showPanel ? "open" : "hidden",
-            std::string(integratorName(frame_.integrator)).c_str(), frame_.state.t,
-            frame_.state.t / elapsed, frame_.lagging ? ", lagging" : "",
+            std::string(integratorName(primary().integrator)).c_str(), primary().state.t,
+            primary().state.t / elapsed, primary().lagging ? ", lagging" : "",
             renderer ? renderer : "unknown renderer");
       }
       return leave(0);
@@ -318,8 +388,8 @@ void Viewer::idle() {
   // Paused with nothing new to show: idle instead of redrawing the same picture.
   const bool fading = !message_.empty() &&
                       seconds(Clock::now() - messageTime_) < kAlarmSeconds + kFadeSeconds + 0.1;
-  const bool still = (view_.paused || frame_.divergence) && drag_ == Drag::None && !fading &&
-                     runner_.published() == drawnPublished_;
+  const bool still = (view_.paused || primary().divergence) && drag_ == Drag::None && !fading &&
+                     runner().published() == drawnPublished_;
   if (still) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     return;
@@ -351,53 +421,73 @@ void Viewer::key(unsigned char key) {
       break;
     case Command::Reload: {
       const std::string file = options_.source.world.string();
-      runner_.post(
-          [this, file](ViewerSession& s) {
-            if (std::optional<std::string> error = s.reload()) {
-              runner_.notify({"reload failed, scene kept: " + *error, true});
-            } else {
-              runner_.notify({"reloaded " + file, false});
-            }
-          },
-          true);
+      forEachRunner([&](SimRunner& r) {
+        r.post(
+            [&r, file](ViewerSession& s) {
+              if (std::optional<std::string> error = s.reload()) {
+                r.notify({"reload failed, scene kept: " + *error, true});
+              } else {
+                r.notify({"reloaded " + file, false});
+              }
+            },
+            true);
+      });
       view_.dtScale = 1.0;
       view_.paused = false;
-      runner_.setPaused(false);
+      forEachRunner([](SimRunner& r) { r.setPaused(false); });
+      if (group_) {  // a reload is quick: wait for it, and start the shared clock over
+        forEachRunner([](SimRunner& r) { r.sync(); });
+        group_->setTarget(runner().frame().state.t);
+        group_->setPaused(false);
+      }
       drag_ = Drag::None;
       break;
     }
     case Command::SwitchIntegrator:
-      if (frame_.divergence) {
+      if (group_) {
+        notify("compare mode: the integrators are the --compare list", true);
+        break;
+      }
+      if (primary().divergence) {
         notify("the simulation diverged" + restartHint(), true);
         break;
       }
-      runner_.post(
+      runner().post(
           [kind = *result.integrator](ViewerSession& s) { s.simulation().setIntegrator(kind); },
           true);
       notify("integrator " + std::string(integratorName(*result.integrator)), false);
       break;
     case Command::TimeStep:
-      runner_.post([scale = view_.dtScale](ViewerSession& s) { s.scaleTimeStep(scale); }, true);
+      postAll([scale = view_.dtScale](ViewerSession& s) { s.scaleTimeStep(scale); }, true);
       notify("time step x" + format("%.4g", view_.dtScale) + " of the world's", false);
       break;
     case Command::StepOnce:
-      if (view_.paused) runner_.stepFrame();
+      if (view_.paused && group_) group_->advanceBy(primary().geometry->frameTime);
+      if (view_.paused && !group_) runner().stepFrame();
       break;
     case Command::Pause:
-      runner_.setPaused(view_.paused);
+      if (group_) {
+        group_->setPaused(view_.paused);
+      } else {
+        runner().setPaused(view_.paused);
+      }
       break;
     case Command::Speed:
-      runner_.setSpeed(view_.speed);
+      if (group_) {
+        group_->setSpeed(view_.speed);
+      } else {
+        runner().setSpeed(view_.speed);
+      }
       notify("playback speed " + format("%.4g", view_.speed) + "x" +
                  (options_.courseTime ? " (ignored in course time)" : ""),
              false);
       break;
     case Command::SaveWorld:
-      runner_.post([this](ViewerSession& s) {
+      runner().post([&r = runner(), pane = group_ ? " (the first pane's)" : ""](ViewerSession& s) {
         const std::optional<std::string> name = freeName("jello-%03d.w");
         if (!name) throw std::runtime_error("jello-000.w ... jello-999.w all exist: not saved");
         s.save(*name);
-        runner_.notify({"saved the current state as " + *name, false});
+        r.notify({std::string("saved the current state") + pane + " as " + *name, false});
       });
       break;
     case Command::None:
@@ -416,7 +506,7 @@ void Viewer::mouse(int button, int state, int x, int y) {
   }
   if (state == GLUT_UP) {
     if (drag_ == Drag::Push || drag_ == Drag::Pull) {
-      runner_.post([](ViewerSession& s) { s.release(); });
+      postAll([](ViewerSession& s) { s.release(); });
     }
     drag_ = Drag::None;
     return;
@@ -430,12 +520,23 @@ void Viewer::mouse(int button, int state, int x, int y) {
     if (!pull) {
       drag_ = Drag::Push;
       pushAccel_ = {};
-    } else if (auto p =
-                   pickPoint(view_.camera, viewport_, frame_.geometry->mesh, frame_.state, x, y)) {
-      drag_ = Drag::Pull;
-      anchor_ = frame_.state.position(*p);
-      runner_.post(
-          [p = *p, anchor = anchor_, r = pullRadius()](ViewerSession& s) { s.pull(p, anchor, r); });
+    } else {
+      // The pane under the cursor picks; every pane's cube is pulled at the same point.
+      const std::vector<Pane> panes = paneLayout(int(runnerCount()), viewport_);
+      const std::optional<PanePixel> at =
+          group_ ? paneAt(panes, viewport_, x, y) : PanePixel{0, double(x), double(y)};
+      if (!at) return;
+      dragPane_ = group_ ? panes[std::size_t(at->pane)].size : viewport_;
+      dragOffsetX_ = x - at->x;
+      dragOffsetY_ = y - at->y;
+      const Frame& f = frames_[std::size_t(at->pane)];
+      if (auto p = pickPoint(view_.camera, dragPane_, f.geometry->mesh, f.state, at->x, at->y)) {
+        drag_ = Drag::Pull;
+        anchor_ = f.state.position(*p);
+        postAll([p = *p, anchor = anchor_, r = pullRadius()](ViewerSession& s) {
+          s.pull(p, anchor, r);
+        });
+      }
     }
   }
 }
@@ -450,10 +551,11 @@ void Viewer::motion(int x, int y) {
     Vec3 a = screenDragToWorld(view_.camera, x - pressX_, y - pressY_) * kPushPerPixel;
     if (norm(a) > kMaxPullAcceleration) a = a * (kMaxPullAcceleration / norm(a));
     pushAccel_ = a;
-    runner_.post([a](ViewerSession& s) { s.push(a); });
+    postAll([a](ViewerSession& s) { s.push(a); });
   } else if (drag_ == Drag::Pull) {
-    const Vec3 target = dragTarget(view_.camera, viewport_, x, y, anchor_);
-    runner_.post([target, r = pullRadius()](ViewerSession& s) {
+    const Vec3 target =
+        dragTarget(view_.camera, dragPane_, x - dragOffsetX_, y - dragOffsetY_, anchor_);
+    postAll([target, r = pullRadius()](ViewerSession& s) {
       if (auto pulled = s.pulling()) s.pull(pulled->first, target, r);
     });
   }

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <vector>
 
 #include "src/integrator_name.h"
 #include "src/world.h"
@@ -25,8 +26,9 @@ struct ViewerOptions {
   bool courseTime = false;  // the original pacing: the world's n*dt per displayed frame
   bool wireframe = false;   // start in wireframe
   bool hud = true;
-  std::optional<bool> panel;  // unset: shown interactively, hidden in recordings
-  int benchmarkFrames = 0;    // > 0: draw this many frames as fast as possible, print frames/s
+  std::optional<bool> panel;            // unset: shown interactively, hidden in recordings
+  std::vector<IntegratorKind> compare;  // 2-6: these integrators side by side
+  int benchmarkFrames = 0;  // > 0: draw this many frames as fast as possible, print frames/s
 };
 
 // Runs the viewer on an already loaded world. Returns the exit code: 0, 1 (no display, a

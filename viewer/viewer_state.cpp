@@ -173,6 +173,30 @@ int stepsPerFrame(double frameTime, double dt) {
   return steps < 1.0 ? 1 : steps > 1e6 ? 1000000 : int(steps);
 }
 
+std::vector<Pane> paneLayout(int count, const Viewport& window) {
+  count = std::max(count, 1);
+  const int rows = count <= 3 ? 1 : 2, columns = (count + rows - 1) / rows;
+  const int w = std::max(1, window.width / columns), h = std::max(1, window.height / rows);
+  std::vector<Pane> panes;
+  for (int i = 0; i < count; ++i) {
+    const int row = i / columns, column = i % columns;
+    panes.push_back({column * w, window.height - (row + 1) * h, {w, h}});
+  }
+  return panes;
+}
+
+std::optional<PanePixel> paneAt(const std::vector<Pane>& panes, const Viewport& window, double x,
+                                double y) {
+  for (std::size_t i = 0; i < panes.size(); ++i) {
+    const Pane& p = panes[i];
+    const double top = window.height - (p.y + p.size.height);  // the pane's top row, y down
+    if (x >= p.x && x < p.x + p.size.width && y >= top && y < top + p.size.height) {
+      return PanePixel{static_cast<int>(i), x - p.x, y - top};
+    }
+  }
+  return std::nullopt;
+}
+
 double recordedFrameSpan(double speed, bool courseTime, double courseFrameTime) {
   return courseTime ? courseFrameTime : speed / kRecordedFramesPerSecond;
 }

@@ -70,6 +70,23 @@ std::vector<std::string> wrapText(const std::string& text, std::size_t width);
 // most dt: the frame time is the world's n*dt0 (fixed when +/- change dt), at least one step.
 int stepsPerFrame(double frameTime, double dt);
 
+// Compare mode: the window split into `count` panes, left to right, then top to bottom (one row
+// for up to three, then two rows). Each pane's lower-left corner is in GL's window coordinates
+// (y up).
+struct Pane {
+  int x = 0, y = 0;
+  Viewport size;
+};
+std::vector<Pane> paneLayout(int count, const Viewport& window);
+// The pane under window pixel (x, y) (GLUT's coordinates: y down), and the pixel in the pane's
+// own coordinates (y down); nothing outside every pane.
+struct PanePixel {
+  int pane;
+  double x, y;
+};
+std::optional<PanePixel> paneAt(const std::vector<Pane>& panes, const Viewport& window, double x,
+                                double y);
+
 // Recorded animations play at the course's 15 frames per second: each recorded frame covers
 // speed/15 simulated seconds, or the world's n*dt in course time.
 inline constexpr double kRecordedFramesPerSecond = 15.0;

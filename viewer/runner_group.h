@@ -1,0 +1,48 @@
+// Integrators side by side: one SimRunner per integrator on the same world, stepped to one shared
+// simulated time. The group's target follows the wall clock times the speed, but moves on only
+// when every running member has reached it, so all panes always show the same instant; a member
+// that diverged stops and no longer holds the others back.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "viewer/sim_runner.h"
+
+namespace jello::viewer {
+
+class RunnerGroup {
+ public:
+  // Each runner in Target pacing on its own thread, `world` under each integrator.
+  RunnerGroup(const SceneSource& source, const World& world,
+              const std::vector<IntegratorKind>& integrators, SimRunner::Options options);
+
+  std::size_t size() const { return runners_.size(); }
+  SimRunner& operator[](std::size_t i) { return *runners_[i]; }
+  const SimRunner& operator[](std::size_t i) const { return *runners_[i]; }
+
+  // Real-time pacing, called once per displayed frame with the wall clock (s): when all have
+  // reached the target, it moves on by speed times the wall time since the last move (at most
+  // kMaxBacklog of wall time). Paused, nothing moves.
+  void tick(double wall);
+  void setSpeed(double speed) { speed_ = speed; }
+  void setPaused(bool paused);
+  // One shared step of `span` simulated seconds (recording, `.` while paused, course time).
+  void advanceBy(double span);
+  double target() const { return target_; }
+  // True when every member that has not diverged shows the target time (to one step).
+  bool allReached() const;
+  // Sets the shared target (recording; after a reload, time starts over).
+  void setTarget(double t);
+
+ private:
+  void setTargetAll();
+
+  std::vector<std::unique_ptr<SimRunner>> runners_;
+  double speed_ = 1.0;
+  bool paused_ = false;
+  double target_ = 0.0;
+  double lastWall_ = -1.0;
+};
+
+}  // namespace jello::viewer
