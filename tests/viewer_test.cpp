@@ -173,7 +173,17 @@ TEST(FieldArrows, SubsampleTheGridAndScaleToTheStrongestForce) {
   EXPECT_EQ(arrows[0].tail, (Vec3{-2.0, -2.0, -2.0}));
   EXPECT_NEAR(norm(arrows[1].head - arrows[1].tail), 0.15, 1e-12);
   EXPECT_NEAR(arrows[1].strength, 0.5, 1e-12);
+  EXPECT_NEAR(arrows[1].magnitude, 2.0, 1e-12);  // N, for the legend
   EXPECT_TRUE(fieldArrows(ForceField{}).empty());
+  EXPECT_EQ(fieldArrows(field).size(), 216u);  // the default: 6 per axis
+  // The colour map runs from blue (weak) to red (strong), continuous at its stops.
+  const auto weak = strengthColour(0.0), strong = strengthColour(1.0);
+  EXPECT_GT(weak[2], weak[0]);
+  EXPECT_GT(strong[0], strong[2]);
+  for (double s : {1.0 / 3.0, 2.0 / 3.0}) {
+    const auto below = strengthColour(s - 1e-9), above = strengthColour(s + 1e-9);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(below[k], above[k], 1e-6);
+  }
 }
 
 TEST(MouseForces, APushAcceleratesEveryPointAlike) {

@@ -66,6 +66,18 @@ std::vector<Vec3> planeInBox(const Plane& plane) {
   return unique;
 }
 
+std::array<float, 3> strengthColour(double s) {
+  // Piecewise linear through four stops.
+  static constexpr float stops[4][3] = {
+      {0.15f, 0.25f, 0.85f}, {0.1f, 0.8f, 0.4f}, {0.95f, 0.9f, 0.15f}, {0.95f, 0.2f, 0.15f}};
+  const double x = std::clamp(s, 0.0, 1.0) * 3.0;
+  const int i = std::min(2, static_cast<int>(x));
+  const float u = static_cast<float>(x - i);
+  std::array<float, 3> c{};
+  for (int k = 0; k < 3; ++k) c[k] = stops[i][k] * (1.0f - u) + stops[i + 1][k] * u;
+  return c;
+}
+
 std::vector<Arrow> fieldArrows(const ForceField& field, int perAxis, double longest) {
   std::vector<Arrow> arrows;
   const int r = field.resolution;
@@ -91,7 +103,8 @@ std::vector<Arrow> fieldArrows(const ForceField& field, int perAxis, double long
         if (magnitude == 0.0) continue;
         const Vec3 tail{-kBoxHalfSize + i * spacing, -kBoxHalfSize + j * spacing,
                         -kBoxHalfSize + k * spacing};
-        arrows.push_back({tail, tail + f * (longest / strongest), magnitude / strongest});
+        arrows.push_back(
+            {tail, tail + f * (longest / strongest), magnitude / strongest, magnitude});
       }
     }
   }

@@ -20,12 +20,16 @@ std::array<std::pair<Vec3, Vec3>, 12> boxEdges();
 std::vector<Vec3> planeInBox(const Plane& plane);
 
 struct Arrow {
-  Vec3 tail;        // m
-  Vec3 head;        // m
-  double strength;  // |F| / max |F| over the drawn nodes, in [0, 1]
+  Vec3 tail;         // m
+  Vec3 head;         // m
+  double strength;   // |F| / max |F| over the drawn nodes, in [0, 1]
+  double magnitude;  // |F|, N
 };
-// At most `perAxis`^3 field nodes, evenly subsampled; the longest arrow is `longest` metres.
-// Nodes with zero force are left out.
-std::vector<Arrow> fieldArrows(const ForceField& field, int perAxis = 10, double longest = 0.3);
+// At most `perAxis`^3 field nodes, evenly subsampled (6 per axis keeps the box readable); the
+// longest arrow is `longest` metres. Nodes with zero force are left out.
+std::vector<Arrow> fieldArrows(const ForceField& field, int perAxis = 6, double longest = 0.4);
+// The colour of an arrow of relative strength s in [0, 1], RGB in [0, 1]: dark blue through
+// green and yellow to red (the legend uses the same map).
+std::array<float, 3> strengthColour(double s);
 
 }  // namespace jello::viewer

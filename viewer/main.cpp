@@ -72,6 +72,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-panel", noPanel, "Start with the panel hidden (key m shows it)")
       ->excludes("--panel");
   app.add_flag("--wireframe", opt.wireframe, "Start in wireframe mode");
+  app.add_flag("--field", opt.field, "Start with the force-field arrows shown (key f)");
   app.add_flag("!--no-hud", opt.hud, "Hide the heads-up line");
   app.add_option("--benchmark", opt.benchmarkFrames,
                  "Draw this many frames as fast as possible, print frames/s and exit")

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <numbers>
 
 // glWindowPos (GL 1.4) is declared only with the extension prototypes.
@@ -132,22 +134,31 @@ void drawPlane(const Plane& plane) {
   glEnd();
 }
 
-void drawArrows(const std::vector<Arrow>& arrows) {
+// Arrows with heads (two barbs in the plane facing the camera), coloured by strength.
+void drawArrows(const std::vector<Arrow>& arrows, const Camera& camera) {
+  const Vec3 toEye = camera.forward() * -1.0;
+  glLineWidth(1.5f);
   glBegin(GL_LINES);
   for (const Arrow& a : arrows) {
-    const float s = static_cast<float>(a.strength);
-    glColor3f(0.3f + 0.7f * s, 0.9f - 0.5f * s, 0.3f);
+    const std::array<float, 3> c = strengthColour(a.strength);
+    glColor3f(c[0], c[1], c[2]);
+    const Vec3 d = a.head - a.tail;
+    const double length = norm(d);
+    if (length <= 0.0) continue;
+    const Vec3 u = d * (1.0 / length);
+    Vec3 side = cross(u, toEye);
+    const double sideLength = norm(side);
+    side = sideLength > 1e-9 ? side * (1.0 / sideLength) : Vec3{};
+    const double barb = 0.3 * length;
     vertex(a.tail);
     vertex(a.head);
-  }
-  glEnd();
-  glPointSize(3.0f);
-  glBegin(GL_POINTS);
-  for (const Arrow& a : arrows) {
-    glColor3f(1.0f, 1.0f, 1.0f);
     vertex(a.head);
+    vertex(a.head - u * barb + side * (0.5 * barb));
+    vertex(a.head);
+    vertex(a.head - u * barb - side * (0.5 * barb));
   }
   glEnd();
+  glLineWidth(1.0f);
 }
 
 // The drawn pane's lower-left corner in the window (glWindowPos is in window coordinates).
@@ -191,6 +202,41 @@ void drawTextBlock(const Viewport& viewport, const std::vector<std::string>& lin
   glMatrixMode(GL_PROJECTION);
   glPopMatrix();
   glMatrixMode(GL_MODELVIEW);
+}
+
+// The field's colour scale at the bottom right: 0 N ... the strongest drawn force.
+void drawLegend(const Viewport& viewport, double strongest) {
+  const int w = 120, h = 10, x = viewport.width - w - 16, y = 30;
+  glMatrixMode(GL_PROJECTION);
+  glPushMatrix();
+  glLoadIdentity();
+  glOrtho(0.0, viewport.width, 0.0, viewport.height, -1.0, 1.0);
+  glMatrixMode(GL_MODELVIEW);
+  glPushMatrix();
+  glLoadIdentity();
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  glColor4f(0.0f, 0.0f, 0.0f, 0.6f);
+  glRecti(x - 8, y - 22, x + w + 8, y + h + 20);
+  glDisable(GL_BLEND);
+  glBegin(GL_QUAD_STRIP);
+  for (int i = 0; i <= 16; ++i) {
+    const std::array<float, 3> c = strengthColour(i / 16.0);
+    glColor3f(c[0], c[1], c[2]);
+    glVertex2i(x + w * i / 16, y);
+    glVertex2i(x + w * i / 16, y + h);
+  }
+  glEnd();
+  glPopMatrix();
+  glMatrixMode(GL_PROJECTION);
+  glPopMatrix();
+  glMatrixMode(GL_MODELVIEW);
+  char label[48];
+  std::snprintf(label, sizeof label, "%.3g N", strongest);
+  glColor3f(0.92f, 0.92f, 0.92f);
+  drawText(x, y - 16, "0");
+  drawText(x + w - kCharWidth * static_cast<int>(std::strlen(label)), y - 16, label);
+  drawText(x, y + h + 5, "field force");
 }
 
 void drawOverlay(const Viewport& viewport, const ViewerState& view, const Overlay& overlay) {
@@ -318,11 +364,18 @@ void drawFrame(const ViewerState& view, const Viewport& viewport, const Scene& s
     drawWireframeCube(view, scene);
   }
   if (scene.world->sphere) drawSphere(*scene.world->sphere);
-  if (view.showField && scene.arrows) drawArrows(*scene.arrows);
+  if (view.showField && scene.arrows) drawArrows(*scene.arrows, view.camera);
   if (scene.pull) drawPull(view, scene);
   if (scene.push) drawPush(view, scene);
   if (scene.world->plane) drawPlane(*scene.world->plane);  // blended: last
   drawOverlay(viewport, view, overlay);
+  if (view.showField && scene.arrows && !scene.arrows->empty()) {
+    double strongest = 0.0;
+    for (const Arrow& a : *scene.arrows) strongest = std::max(strongest, a.magnitude);
+    glDisable(GL_DEPTH_TEST);
+    drawLegend(viewport, strongest);
+    glEnable(GL_DEPTH_TEST);
+  }
   glDisable(GL_SCISSOR_TEST);
 }
 

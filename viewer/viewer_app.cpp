@@ -67,6 +67,7 @@ class Viewer {
     }
     view_.mode = options.wireframe ? DisplayMode::Wireframe : DisplayMode::Shaded;
     view_.showHud = options.hud;
+    view_.showField = options.field;
     view_.showPanel = options.panel.value_or(!recording());  // recordings: the scene alone
     view_.speed = options.speed;
     frames_.resize(group_ ? group_->size() : 1);
@@ -413,6 +414,9 @@ void Viewer::screenshot() {
 void Viewer::key(unsigned char key) {
   if (panel_.key(key, lastX_, lastY_)) return glutPostRedisplay();  // typing into the panel
   const KeyResult result = handleKey(view_, key);
+  if (key == 'f' && view_.showField && primary().geometry->arrows.empty()) {
+    notify("this world has no force field (or it is zero everywhere): no arrows to draw", false);
+  }
   switch (result.command) {
     case Command::Quit:
       return leave(0);

@@ -25,6 +25,7 @@ struct ViewerOptions {
   double speed = 1.0;       // playback: simulated seconds per wall second
   bool courseTime = false;  // the original pacing: the world's n*dt per displayed frame
   bool wireframe = false;   // start in wireframe
+  bool field = false;       // start with the field arrows shown
   bool hud = true;
   std::optional<bool> panel;            // unset: shown interactively, hidden in recordings
   std::vector<IntegratorKind> compare;  // 2-6: these integrators side by side
