@@ -22,3 +22,8 @@ $create -o worlds/cube16.w --cube 16 --field-resolution 0 --dt 2.5e-4
 # integrators keep of its energy and angular momentum (scripts/integrator-table.py).
 $create -o worlds/spinning-k1e4.w --integrator implicit --k-elastic 1e4 --d-elastic 0 --no-plane \
   --field-resolution 0 --pose stretched --stretch 1.05 --spin 2 --velocity 0 0 0 --dt 0.01
+# The showcase (scripts/showcase.sh): dropped under gravity onto a spiral ramp (1.5 turns) that
+# winds around a cone (the cone and spiral extensions); frictionless, it slides down the ramp.
+$create -o worlds/showcase.w --no-plane --field gravity --field-resolution 2 --pose translated \
+  --translate 0.62 0.26 1.0 --velocity 0 0 0 --cone 0 0 0.3 0 0 -1 2.3 0.7 \
+  --spiral 0 0 0.6 0.75 1.95 1.3 1.5 0.25 --dt 5e-4

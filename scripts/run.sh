@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The main job: installs what is missing, builds (Release) and opens the viewer on
-# worlds/jello.w. Without a display it records the animation instead: 300 frames (20 s of
-# animation at 15 frames/s) into frames/000.jpg ... under Xvfb.
+# worlds/jello.w. Without a display it records the showcase instead: 300 frames (20 s of
+# simulation, played at 15 frames/s) of worlds/showcase.w into frames/000.jpg ... under Xvfb.
 # Arguments go to the viewer, e.g. `scripts/run.sh --integrator implicit --dt 0.01`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,5 +11,5 @@ viewer=build/release/bin/jello
 if [ -n "${DISPLAY:-}" ]; then
   exec "$viewer" worlds/jello.w "$@"
 fi
-echo "run: no display: recording worlds/jello.w to frames/ under Xvfb"
-exec xvfb-run -a -s "-screen 0 1024x768x24" "$viewer" worlds/jello.w --record frames --frames 300 "$@"
+echo "run: no display: recording the showcase (worlds/showcase.w) to frames/ under Xvfb"
+exec xvfb-run -a -s "-screen 0 1024x768x24" "$viewer" worlds/showcase.w --record frames --frames 300 "$@"

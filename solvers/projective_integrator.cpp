@@ -83,7 +83,8 @@ void ProjectiveIntegrator::contactWeights(const Model& model, const double* x) {
   }
   const auto& plane = model.plane();
   const auto& sphere = model.sphere();
-  if (!plane && !sphere) return;
+  const auto& obstacles = model.obstacles();
+  if (!plane && !sphere && obstacles.empty()) return;
   for (int p = 0; p < n; ++p) {
     const Vec3 xp{x[p], x[n + p], x[2 * n + p]};
     double w = 0.0;
@@ -92,6 +93,9 @@ void ProjectiveIntegrator::contactWeights(const Model& model, const double* x) {
     }
     if (sphere && norm(xp - sphere->sphere().center) < sphere->sphere().radius) {
       w += sphere->constants().stiffness;
+    }
+    for (const ObstacleContact& o : obstacles) {
+      if (o.inside(xp)) w += o.constants().stiffness;
     }
     for (int c = 0; c < 3; ++c) weights_[c][p] += w;
   }

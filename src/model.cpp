@@ -16,6 +16,8 @@ ModelSpec modelSpecFromWorld(const World& world) {
   spec.contact = {world.kCollision, world.dCollision};
   spec.plane = world.plane;
   spec.sphere = world.sphere;
+  spec.cone = world.cone;
+  spec.spiral = world.spiral;
   spec.field = world.field;
   return spec;
 }
@@ -33,6 +35,8 @@ Model::Model(ModelSpec spec)
   if (spec.walls) walls_.emplace(spec.contact);
   if (spec.plane) plane_.emplace(*spec.plane, spec.contact);
   if (spec.sphere) sphere_.emplace(*spec.sphere, spec.contact);
+  if (spec.cone) obstacles_.emplace_back(*spec.cone, spec.contact);
+  if (spec.spiral) obstacles_.emplace_back(*spec.spiral, spec.contact);
   if (!spec.field.empty()) {
     FieldForces field(std::move(spec.field));
     if (!field.isZero()) field_.emplace(std::move(field));
@@ -59,6 +63,10 @@ void Model::forces(const double* x, const double* v, double* f) const {
     sphere_->accumulate(x, v, f, n_);
     counters_->sphere.fetch_add(1, std::memory_order_relaxed);
   }
+  for (const ObstacleContact& o : obstacles_) {
+    o.accumulate(x, v, f, n_);
+    counters_->obstacles.fetch_add(1, std::memory_order_relaxed);
+  }
   if (field_) {
     field_->accumulate(x, f, n_);
     counters_->field.fetch_add(1, std::memory_order_relaxed);
@@ -73,7 +81,7 @@ EffectCounts Model::counts() const {
   const auto get = [](const std::atomic<long>& c) { return c.load(std::memory_order_relaxed); };
   const Counters& c = *counters_;
   return {get(c.springs), get(c.walls), get(c.wallsSkipped), get(c.plane),
-          get(c.sphere),  get(c.field), get(c.user)};
+          get(c.sphere),  get(c.field), get(c.user),         get(c.obstacles)};
 }
 
 void Model::setUserForce(const Eigen::VectorXd& f) {
@@ -105,6 +113,7 @@ void Model::addJacobian(const double* x, JacobianBlocks& out) const {
   if (walls_) walls_->addJacobian(x, n_, out);
   if (plane_) plane_->addJacobian(x, n_, out);
   if (sphere_) sphere_->addJacobian(x, n_, out);
+  for (const ObstacleContact& o : obstacles_) o.addJacobian(x, n_, out);
   if (field_) field_->addJacobian(x, n_, out);
 }
 
@@ -124,6 +133,9 @@ bool Model::contactBegins(const double* x0, const double* x1) const {
     if (sphere_) {
       const Sphere& s = sphere_->sphere();
       if (norm(b - s.center) < s.radius && norm(a - s.center) >= s.radius) return true;
+    }
+    for (const ObstacleContact& o : obstacles_) {
+      if (o.inside(b) && !o.inside(a)) return true;
     }
   }
   return false;
@@ -160,6 +172,7 @@ double Model::potentialEnergy(const double* x) const {
   if (walls_) e += walls_->energy(x, n_);
   if (plane_) e += plane_->energy(x, n_);
   if (sphere_) e += sphere_->energy(x, n_);
+  for (const ObstacleContact& o : obstacles_) e += o.energy(x, n_);
   return e;
 }
 
@@ -176,6 +189,7 @@ Energy Model::energy(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const {
   if (walls_) e.contact += walls_->energy(x.data(), n_);
   if (plane_) e.contact += plane_->energy(x.data(), n_);
   if (sphere_) e.contact += sphere_->energy(x.data(), n_);
+  for (const ObstacleContact& o : obstacles_) e.contact += o.energy(x.data(), n_);
   return e;
 }
 

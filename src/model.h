@@ -14,6 +14,7 @@
 
 #include "src/contact.h"
 #include "src/force_field.h"
+#include "src/obstacles.h"
 #include "src/spring_forces.h"
 #include "src/state.h"
 #include "src/world.h"
@@ -28,6 +29,8 @@ struct ModelSpec {
   ContactConstants contact;
   std::optional<Plane> plane;
   std::optional<Sphere> sphere;
+  std::optional<Cone> cone;
+  std::optional<Spiral> spiral;
   ForceField field;
 };
 
@@ -51,6 +54,7 @@ struct EffectCounts {
   long sphere = 0;
   long field = 0;
   long user = 0;
+  long obstacles = 0;  // evaluations of the cone and spiral contacts
 };
 
 class Model {
@@ -105,6 +109,8 @@ class Model {
   const std::optional<WallContact>& walls() const { return walls_; }
   const std::optional<PlaneContact>& plane() const { return plane_; }
   const std::optional<SphereContact>& sphere() const { return sphere_; }
+  // The cone and the spiral ramp, where the scene has them.
+  const std::vector<ObstacleContact>& obstacles() const { return obstacles_; }
   const std::optional<FieldForces>& field() const { return field_; }
   bool hasWalls() const { return walls_.has_value(); }
   bool hasPlane() const { return plane_.has_value(); }
@@ -127,10 +133,12 @@ class Model {
   std::optional<WallContact> walls_;
   std::optional<PlaneContact> plane_;
   std::optional<SphereContact> sphere_;
+  std::vector<ObstacleContact> obstacles_;
   std::optional<FieldForces> field_;
   std::optional<Eigen::VectorXd> userForce_;
   struct Counters {
-    std::atomic<long> springs{0}, walls{0}, wallsSkipped{0}, plane{0}, sphere{0}, field{0}, user{0};
+    std::atomic<long> springs{0}, walls{0}, wallsSkipped{0}, plane{0}, sphere{0}, field{0}, user{0},
+        obstacles{0};
   };
   // unique_ptr keeps the model movable; relaxed increments: counts, not synchronization.
   std::unique_ptr<Counters> counters_ = std::make_unique<Counters>();

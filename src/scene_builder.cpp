@@ -93,6 +93,8 @@ World buildWorld(const SceneSpec& spec) {
   w.mass = spec.mass;
   w.plane = spec.plane;
   w.sphere = spec.sphere;
+  w.cone = spec.cone;
+  w.spiral = spec.spiral;
   w.cubeResolution = spec.cubeResolution;
 
   const int r = spec.fieldResolution;

@@ -43,6 +43,8 @@ struct SceneSpec {
   Vec3 velocity{10.0, -10.0, 20.0};  // m/s, uniform
   double spin = 0.0;  // rad/s about the z axis through the cube's centre, added to velocity
   std::optional<Sphere> sphere;
+  std::optional<Cone> cone;
+  std::optional<Spiral> spiral;
 };
 
 // The defaults above are the original course creator's: SceneSpec{} builds createWorld's jello.w.

@@ -23,6 +23,33 @@ struct Sphere {
   double radius = 0.0;  // m, > 0
 };
 
+// Solid right circular cone (world-file extension `cone`): apex, axis direction from the apex
+// towards the base (any non-zero length), height and base radius.
+struct Cone {
+  Vec3 apex;            // m
+  Vec3 axis;            // non-zero; the reader keeps it as written
+  double height = 0.0;  // m, > 0
+  double radius = 0.0;  // m, > 0, of the base disk
+
+  bool operator==(const Cone&) const = default;
+};
+
+// Solid spiral ramp (world-file extension `spiral`): a slab of thickness `thickness` below a
+// helicoid around the vertical axis through (cx, cy), between radii rInner and rOuter, whose top
+// descends by `pitch` per turn counter-clockwise from height zTop at angle 0 (the +x direction)
+// through `turns` turns.
+struct Spiral {
+  double cx = 0.0, cy = 0.0;  // m
+  double zTop = 0.0;          // m
+  double rInner = 0.0;        // m, >= 0
+  double rOuter = 0.0;        // m, > rInner
+  double pitch = 0.0;         // m per turn, > thickness
+  double turns = 0.0;         // > 0
+  double thickness = 0.0;     // m, > 0
+
+  bool operator==(const Spiral&) const = default;
+};
+
 // Force field sampled on res^3 nodes covering the box [-2,2]^3; node (i,j,k) has flat index
 // i*res*res + j*res + k. resolution 0 means no field.
 struct ForceField {
@@ -52,12 +79,15 @@ struct World {
   std::vector<Vec3> positions;   // m, N^3 entries, point (i,j,k) at index i*N*N + j*N + k
   std::vector<Vec3> velocities;  // m/s, N^3 entries
   std::optional<Sphere> sphere;
+  std::optional<Cone> cone;
+  std::optional<Spiral> spiral;
 
   int numPoints() const { return cubeResolution * cubeResolution * cubeResolution; }
   // True when a file of this world needs the extension block (so the original loader would
   // not read it as written).
   bool usesExtensions() const {
-    return cubeResolution != kDefaultCubeResolution || sphere.has_value() ||
+    return cubeResolution != kDefaultCubeResolution || sphere.has_value() || cone.has_value() ||
+           spiral.has_value() ||
            (integrator != IntegratorKind::Euler && integrator != IntegratorKind::RK4);
   }
 };

@@ -108,7 +108,7 @@ class Tokenizer {
 };
 
 bool isExtensionKeyword(std::string_view s) {
-  return s == "integrator" || s == "cube" || s == "sphere";
+  return s == "integrator" || s == "cube" || s == "sphere" || s == "cone" || s == "spiral";
 }
 
 bool looksNumeric(std::string_view s) {
@@ -128,7 +128,7 @@ bool completeCube(std::size_t count) {
 // Reads the extension block: one keyword per entry, each at most once.
 void readExtensions(Tokenizer& in, Token keyword, World& world, const ReaderLimits& limits) {
   bool seenCube = false;
-  bool seenSphere = false;
+  bool seenSphere = false, seenCone = false, seenSpiral = false;
   bool seenIntegrator = false;
   while (!keyword.text.empty()) {
     if (keyword.text == "integrator") {
@@ -163,8 +163,47 @@ void readExtensions(Tokenizer& in, Token keyword, World& world, const ReaderLimi
       s.center.z = in.number("sphere centre z");
       s.radius = in.positive("sphere radius");
       world.sphere = s;
+    } else if (keyword.text == "cone") {
+      if (seenCone) in.fail(keyword, "extension 'cone' given twice");
+      seenCone = true;
+      Cone c;
+      c.apex.x = in.number("cone apex x");
+      c.apex.y = in.number("cone apex y");
+      c.apex.z = in.number("cone apex z");
+      c.axis.x = in.number("cone axis x");
+      c.axis.y = in.number("cone axis y");
+      c.axis.z = in.number("cone axis z");
+      if (c.axis.x == 0.0 && c.axis.y == 0.0 && c.axis.z == 0.0) {
+        in.fail(in.lastToken(), "the cone's axis must not be zero");
+      }
+      c.height = in.positive("cone height");
+      c.radius = in.positive("cone base radius");
+      world.cone = c;
+    } else if (keyword.text == "spiral") {
+      if (seenSpiral) in.fail(keyword, "extension 'spiral' given twice");
+      seenSpiral = true;
+      Spiral s;
+      s.cx = in.number("spiral axis x");
+      s.cy = in.number("spiral axis y");
+      s.zTop = in.number("spiral top height");
+      s.rInner = in.number("spiral inner radius");
+      if (s.rInner < 0.0) in.fail(in.lastToken(), "the spiral's inner radius must be >= 0");
+      s.rOuter = in.positive("spiral outer radius");
+      if (!(s.rOuter > s.rInner)) {
+        in.fail(in.lastToken(), "the spiral's outer radius must exceed its inner radius");
+      }
+      s.pitch = in.positive("spiral pitch");
+      s.turns = in.positive("spiral turns");
+      if (s.turns > 100.0) in.fail(in.lastToken(), "the spiral has at most 100 turns");
+      s.thickness = in.positive("spiral thickness");
+      if (!(s.thickness < s.pitch)) {
+        in.fail(in.lastToken(), "the spiral's thickness must be less than its pitch");
+      }
+      world.spiral = s;
     } else {
-      in.fail(keyword, "unknown trailing content (extension keywords: integrator, cube, sphere)");
+      in.fail(keyword,
+              "unknown trailing content (extension keywords: integrator, cube, sphere, cone, "
+              "spiral)");
     }
     keyword = in.next();
   }
@@ -284,8 +323,8 @@ World parseWorld(std::string_view text, const std::string& name, const ReaderLim
   while (!t.text.empty() && !isExtensionKeyword(t.text)) {
     if (completeCube(values.size()) && !looksNumeric(t.text)) {
       in.fail(t,
-              "unknown trailing content after the velocities (extension keywords: cube, "
-              "sphere)");
+              "unknown trailing content after the velocities (extension keywords: integrator, "
+              "cube, sphere, cone, spiral)");
     }
     values.push_back(in.toNumber(t, "a position or velocity"));
     tokens.push_back(t);

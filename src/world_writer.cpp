@@ -79,6 +79,22 @@ std::string formatWorld(const World& w, NumberFormat format) {
     line.pop_back();
     p.text(line);
   }
+  if (w.cone) {
+    const Cone& c = *w.cone;
+    Printer q(format);
+    q.numbers({c.apex.x, c.apex.y, c.apex.z, c.axis.x, c.axis.y, c.axis.z, c.height, c.radius});
+    std::string line = "cone " + q.take();
+    line.pop_back();
+    p.text(line);
+  }
+  if (w.spiral) {
+    const Spiral& s = *w.spiral;
+    Printer q(format);
+    q.numbers({s.cx, s.cy, s.zTop, s.rInner, s.rOuter, s.pitch, s.turns, s.thickness});
+    std::string line = "spiral " + q.take();
+    line.pop_back();
+    p.text(line);
+  }
   return p.take();
 }
 

@@ -9,6 +9,7 @@
 #include <cstdlib>
 
 #include "src/state.h"
+#include "src/world_writer.h"
 #include "tests/test_support.h"
 #include "viewer/camera.h"
 #include "viewer/image_writer.h"
@@ -201,6 +202,41 @@ TEST(Recording, CompareModeDrawsEachIntegratorInItsOwnPane) {
   // Mid-window, on the gutter's column: the panes' split, not a stretched single view.
   const Rgb gutter = pixel(image, 319, 470);
   EXPECT_LT(gutter.r + gutter.g + gutter.b, 3 * 30);
+}
+
+// The cone and the spiral are drawn where they are: lit surface colour at the projection of a
+// point on each surface facing the camera (the cube far away behind them, out of the way).
+TEST(Recording, TheConeAndTheSpiralAreDrawnWhereTheyAre) {
+  test::TempDir dir;
+  World w = test::loadWorld("jello.w");
+  w.plane.reset();
+  Vec3 centre;  // the cube to the far top corner, behind everything
+  for (const Vec3& x : w.positions) centre += x * (1.0 / double(w.positions.size()));
+  for (Vec3& x : w.positions) x = x - centre + Vec3{-1.4, -1.4, 1.4};
+  w.cone = Cone{{-1.0, 1.0, 0.0}, {0.0, 0.0, -1.0}, 2.0, 0.8};  // apex up, base on the floor
+  w.spiral = Spiral{0.6, -0.6, 0.5, 0.3, 1.3, 1.0, 1.0, 0.2};
+  const auto path = dir.path() / "obstacles.w";
+  writeWorld(w, path);
+  const Outcome r =
+      run(headless(path.string() + " --no-hud --frames 1 --record " + (dir.path() / "f").string()));
+  ASSERT_EQ(r.code, 0) << r.output;
+  const Image image = readImage(dir.path() / "f" / "000.jpg");
+  const Camera camera;
+  const Viewport viewport{640, 480};
+  // The cone's slope halfway down, on the side facing the eye (horizontally).
+  const Vec3 toEye = Vec3{camera.eye().x, camera.eye().y, 0.0} *
+                     (1.0 / std::hypot(camera.eye().x, camera.eye().y));
+  const auto c = project(camera, viewport, Vec3{-1.0, 1.0, -1.0} + toEye * 0.38);
+  ASSERT_TRUE(c.has_value());
+  const Rgb cone = pixel(image, int(c->x), int(c->y));
+  EXPECT_FALSE(isBackground(cone));
+  EXPECT_GT(cone.r, cone.b + 10) << cone.r << " " << cone.g << " " << cone.b;  // warm grey
+  // The ramp's top a quarter turn on, mid-width.
+  const auto q = project(camera, viewport, Vec3{0.6, -0.6 + 0.8, 0.5 - 0.25 + 0.01});
+  ASSERT_TRUE(q.has_value());
+  const Rgb ramp = pixel(image, int(q->x), int(q->y));
+  EXPECT_FALSE(isBackground(ramp));
+  EXPECT_GT(ramp.g, ramp.r) << ramp.r << " " << ramp.g << " " << ramp.b;  // green-grey
 }
 
 TEST(Recording, ThirtyFramesAreThirtyValidChangingJpegs) {

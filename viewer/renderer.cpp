@@ -116,6 +116,96 @@ void drawSphere(const Sphere& sphere) {
   glDisable(GL_LIGHTING);
 }
 
+void normal(const Vec3& n) {
+  glNormal3d(n.x, n.y, n.z);
+}
+
+// Lit like the sphere, a warmer grey: the cone's lateral surface (per-vertex normals of the
+// slope) and its base disk, clipped to the box.
+void drawCone(const Cone& cone) {
+  const double am = std::max({std::abs(cone.axis.x), std::abs(cone.axis.y), std::abs(cone.axis.z)});
+  const Vec3 scaled = cone.axis * (1.0 / am);
+  const Vec3 d = scaled * (1.0 / norm(scaled));
+  const Vec3 a = std::abs(d.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+  const Vec3 e1 = cross(d, a) * (1.0 / norm(cross(d, a))), e2 = cross(d, e1);
+  const double H = cone.height, R = cone.radius, L = std::hypot(H, R);
+  const Vec3 base = cone.apex + d * H;
+  constexpr int kSlices = 64;
+  glEnable(GL_LIGHTING);
+  const GLfloat diffuse[] = {0.68f, 0.6f, 0.5f, 1.0f};
+  glMaterialfv(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE, diffuse);
+  clipToBox(true);
+  glBegin(GL_TRIANGLES);
+  for (int i = 0; i < kSlices; ++i) {
+    const double a0 = 2.0 * std::numbers::pi * i / kSlices,
+                 a1 = 2.0 * std::numbers::pi * (i + 1) / kSlices;
+    const Vec3 r0 = e1 * std::cos(a0) + e2 * std::sin(a0),
+               r1 = e1 * std::cos(a1) + e2 * std::sin(a1);
+    const Vec3 n0 = (r0 * H - d * R) * (1.0 / L), n1 = (r1 * H - d * R) * (1.0 / L);
+    normal((n0 + n1) * 0.5);
+    vertex(cone.apex);
+    normal(n0);
+    vertex(base + r0 * R);
+    normal(n1);
+    vertex(base + r1 * R);
+    normal(d);  // the base disk
+    vertex(base);
+    vertex(base + r1 * R);
+    vertex(base + r0 * R);
+  }
+  glEnd();
+  clipToBox(false);
+  glDisable(GL_LIGHTING);
+}
+
+// The spiral ramp's slab: its helicoid top and bottom, and its inner and outer walls.
+void drawSpiral(const Spiral& s) {
+  const double c = s.pitch / (2.0 * std::numbers::pi), span = 2.0 * std::numbers::pi * s.turns;
+  const int steps = std::max(16, static_cast<int>(48 * s.turns));
+  constexpr int kRadial = 6;
+  const auto point = [&](double r, double theta, double dz) {
+    return Vec3{s.cx + r * std::cos(theta), s.cy + r * std::sin(theta), s.zTop - c * theta + dz};
+  };
+  const auto topNormal = [&](double r, double theta) {
+    const Vec3 n{c * std::sin(theta), -c * std::cos(theta), r};
+    return n * (1.0 / norm(n));
+  };
+  glEnable(GL_LIGHTING);
+  const GLfloat diffuse[] = {0.5f, 0.62f, 0.55f, 1.0f};
+  glMaterialfv(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE, diffuse);
+  clipToBox(true);
+  for (int j = 0; j < kRadial; ++j) {
+    const double r0 = s.rInner + (s.rOuter - s.rInner) * j / kRadial;
+    const double r1 = s.rInner + (s.rOuter - s.rInner) * (j + 1) / kRadial;
+    for (double side : {0.0, -s.thickness}) {  // top, then bottom
+      glBegin(GL_QUAD_STRIP);
+      for (int i = 0; i <= steps; ++i) {
+        const double theta = span * i / steps;
+        const double flip = side == 0.0 ? 1.0 : -1.0;
+        normal(topNormal(r0, theta) * flip);
+        vertex(point(r0, theta, side));
+        normal(topNormal(r1, theta) * flip);
+        vertex(point(r1, theta, side));
+      }
+      glEnd();
+    }
+  }
+  for (double r : {s.rInner, s.rOuter}) {  // the walls
+    if (r <= 0.0) continue;
+    glBegin(GL_QUAD_STRIP);
+    for (int i = 0; i <= steps; ++i) {
+      const double theta = span * i / steps;
+      const double out = r == s.rOuter ? 1.0 : -1.0;
+      normal(Vec3{std::cos(theta), std::sin(theta), 0.0} * out);
+      vertex(point(r, theta, 0.0));
+      vertex(point(r, theta, -s.thickness));
+    }
+    glEnd();
+  }
+  clipToBox(false);
+  glDisable(GL_LIGHTING);
+}
+
 void drawPlane(const Plane& plane) {
   const std::vector<Vec3> polygon = planeInBox(plane);
   if (polygon.empty()) return;
@@ -364,6 +454,8 @@ void drawFrame(const ViewerState& view, const Viewport& viewport, const Scene& s
     drawWireframeCube(view, scene);
   }
   if (scene.world->sphere) drawSphere(*scene.world->sphere);
+  if (scene.world->cone) drawCone(*scene.world->cone);
+  if (scene.world->spiral) drawSpiral(*scene.world->spiral);
   if (view.showField && scene.arrows) drawArrows(*scene.arrows, view.camera);
   if (scene.pull) drawPull(view, scene);
   if (scene.push) drawPush(view, scene);

@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
   jello::SceneSpec spec;
   std::string out = "jello.w";
   std::string integrator = "rk4";
-  std::vector<double> plane, sphere, velocity, translate, axis;
+  std::vector<double> plane, sphere, cone, spiral, velocity, translate, axis;
   std::optional<double> fieldStrength;
   bool noPlane = false, legacy = false;
 
@@ -118,6 +118,14 @@ int main(int argc, char** argv) {
   app.add_option("--spin", spec.spin,
                  "Initial spin about the vertical axis through the cube's centre, rad/s");
   app.add_option("--sphere", sphere, "Sphere obstacle CX CY CZ R (an extension)")->expected(4);
+  app.add_option("--cone", cone,
+                 "Cone obstacle: apex AX AY AZ, axis DX DY DZ (apex to base), height H, base "
+                 "radius R (an extension)")
+      ->expected(8);
+  app.add_option("--spiral", spiral,
+                 "Spiral ramp obstacle: axis CX CY, top height Z, radii RIN ROUT, pitch P (m per "
+                 "turn), turns T, thickness W (an extension)")
+      ->expected(8);
   app.add_option("--cube", spec.cubeResolution,
                  "Cube resolution N: N^3 points (default 8; other values are an extension)")
       ->check(jello::cli::range(2, 64));
@@ -145,6 +153,14 @@ int main(int argc, char** argv) {
   if (noPlane) spec.plane.reset();
   if (!plane.empty()) spec.plane = jello::Plane{plane[0], plane[1], plane[2], plane[3]};
   if (!sphere.empty()) spec.sphere = jello::Sphere{{sphere[0], sphere[1], sphere[2]}, sphere[3]};
+  if (!cone.empty()) {
+    spec.cone =
+        jello::Cone{{cone[0], cone[1], cone[2]}, {cone[3], cone[4], cone[5]}, cone[6], cone[7]};
+  }
+  if (!spiral.empty()) {
+    spec.spiral = jello::Spiral{spiral[0], spiral[1], spiral[2], spiral[3],
+                                spiral[4], spiral[5], spiral[6], spiral[7]};
+  }
   if (!velocity.empty()) spec.velocity = toVec3(velocity);
   if (!translate.empty()) spec.translate = toVec3(translate);
   if (!axis.empty()) spec.rotateAxis = toVec3(axis);
@@ -165,8 +181,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "jello-create-world: error: %s\n", e.what());
     return 1;
   }
-  std::printf("wrote %s (%d points%s%s, field %s)\n", out.c_str(), world.numPoints(),
+  std::printf("wrote %s (%d points%s%s%s%s, field %s)\n", out.c_str(), world.numPoints(),
               world.plane ? ", plane" : "", world.sphere ? ", sphere" : "",
+              world.cone ? ", cone" : "", world.spiral ? ", spiral" : "",
               world.field.resolution
                   ? (field + " at " + std::to_string(world.field.resolution) + "^3 nodes").c_str()
                   : "none");

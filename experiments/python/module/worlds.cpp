@@ -79,7 +79,8 @@ bool sameWorld(const World& a, const World& b) {
          a.dCollision == b.dCollision && a.mass == b.mass && samePlane(a.plane, b.plane) &&
          a.field.resolution == b.field.resolution && samePoints(a.field.forces, b.field.forces) &&
          a.cubeResolution == b.cubeResolution && samePoints(a.positions, b.positions) &&
-         samePoints(a.velocities, b.velocities) && sameSphere(a.sphere, b.sphere);
+         samePoints(a.velocities, b.velocities) && sameSphere(a.sphere, b.sphere) &&
+         a.cone == b.cone && a.spiral == b.spiral;
 }
 
 }  // namespace
