@@ -9,7 +9,8 @@ cd "$(dirname "$0")/.."
 dir=${1:-showcase}
 shift || true
 [ -x build/release/bin/jello ] || scripts/build.sh release >/dev/null
-viewer=(build/release/bin/jello worlds/showcase.w --record "$dir" --frames 300 --size 640x480 --no-hud "$@")
+viewer=(build/release/bin/jello worlds/showcase.w --record "$dir" --frames 300 --size 640x480 --no-hud
+  --texture builtin "$@")
 if [ -n "${DISPLAY:-}" ]; then
   "${viewer[@]}"
 else

@@ -60,12 +60,13 @@ class Frames : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new test::TempDir;
-    for (const char* mode : {"shaded", "wireframe", "panel"}) {
+    for (const char* mode : {"shaded", "wireframe", "panel", "textured"}) {
       const std::string out = (dir_->path() / mode).string();
       const std::string m = mode;
-      const Outcome r = run(headless(world("jello.w") + " --no-hud --frames 1 --record " + out +
-                                     (m == "wireframe" ? " --wireframe" : "") +
-                                     (m == "panel" ? " --panel" : "")));
+      const Outcome r =
+          run(headless(world("jello.w") + " --no-hud --frames 1 --record " + out +
+                       (m == "wireframe" ? " --wireframe" : "") + (m == "panel" ? " --panel" : "") +
+                       (m == "textured" ? " --texture builtin" : "")));
       ASSERT_EQ(r.code, 0) << r.output;
     }
   }
@@ -156,6 +157,17 @@ TEST_F(Frames, WireframeAndShadedModesDiffer) {
   }
   EXPECT_GT(lines, total / 10);
   EXPECT_LT(lines, total);
+}
+
+TEST_F(Frames, TheTextureChangesTheCubeButNotItsPlaceOrColour) {
+  const Image plain = frame("shaded"), textured = frame("textured");
+  EXPECT_GT(meanDifference(plain, textured), 0.2);
+  const State s = initialState(test::loadWorld("jello.w"));
+  Vec3 centroid;
+  for (int p = 0; p < s.numPoints(); ++p) centroid += s.position(p) * (1.0 / s.numPoints());
+  const auto c = project(Camera{}, Viewport{640, 480}, centroid);
+  const Rgb centre = pixel(textured, int(c->x), int(c->y));
+  EXPECT_GT(centre.r, 2 * centre.g) << centre.r << " " << centre.g << " " << centre.b;
 }
 
 TEST_F(Frames, ThePanelIsDrawnAtTheRightAndLeavesTheRestAlone) {

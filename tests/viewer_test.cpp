@@ -13,6 +13,7 @@
 #include "viewer/image_writer.h"
 #include "viewer/interaction.h"
 #include "viewer/surface.h"
+#include "viewer/texture.h"
 #include "viewer/viewer_session.h"
 #include "viewer/viewer_state.h"
 
@@ -108,6 +109,40 @@ TEST(SurfaceMesh, HasTheSurfacePointsAndTwoOutwardTrianglesPerQuad) {
       EXPECT_GT(dot(cross(b - a, c - a), centroid), 0.0) << "inward triangle, n = " << n;
     }
   }
+}
+
+TEST(SurfaceMesh, TextureCoordinatesCoverEachFaceOnce) {
+  const Lattice lattice{5};
+  const SurfaceMesh mesh = surfaceMesh(lattice);
+  ASSERT_EQ(mesh.uv.size(), mesh.triangles.size());
+  double area = 0.0;
+  for (const auto& t : mesh.uv) {
+    for (const auto& c : t) {
+      EXPECT_GE(c[0], 0.0f);
+      EXPECT_LE(c[1], 1.0f);
+    }
+    area += 0.5 * std::abs((t[1][0] - t[0][0]) * (t[2][1] - t[0][1]) -
+                           (t[2][0] - t[0][0]) * (t[1][1] - t[0][1]));
+  }
+  EXPECT_NEAR(area, 6.0, 1e-5);  // six faces, each the unit square once
+}
+
+TEST(Texture, TheBuiltInOneIsJelloRedAndFilesBecomePowerOfTwoSquares) {
+  const Image t = builtinTexture(64);
+  ASSERT_EQ(t.rgb.size(), 64u * 64u * 3u);
+  double r = 0, g = 0;
+  for (std::size_t i = 0; i < t.rgb.size(); i += 3) {
+    r += t.rgb[i];
+    g += t.rgb[i + 1];
+  }
+  EXPECT_GT(r, 2.5 * g);
+  test::TempDir dir;
+  Image odd{100, 30, std::vector<std::uint8_t>(100 * 30 * 3, 200)};
+  writeJpeg(dir.path() / "odd.jpg", odd);
+  const Image loaded = loadTexture(dir.path() / "odd.jpg");
+  EXPECT_EQ(loaded.width, 128);
+  EXPECT_EQ(loaded.height, 128);
+  EXPECT_THROW((void)loadTexture(dir.path() / "missing.png"), std::runtime_error);
 }
 
 TEST(SurfaceMesh, VertexNormalsPointOutOfTheirFaceAndAreNeverNaN) {
@@ -309,7 +344,7 @@ TEST(Keys, TimeStepZoomCameraResetAndPullRadius) {
   handleKey(v, '-');
   EXPECT_EQ(v.dtScale, 0.5);
   handleKey(v, 'z');
-  EXPECT_LT(v.camera.radius, Camera{}.radius);
+  EXPECT_NEAR(v.camera.radius, 0.9 * Camera{}.radius, 1e-12);  // 10% a press
   handleKey(v, 'x');
   handleKey(v, 'x');
   EXPECT_GT(v.camera.radius, Camera{}.radius);
@@ -324,10 +359,29 @@ TEST(Keys, TimeStepZoomCameraResetAndPullRadius) {
   EXPECT_TRUE(std::isinf(pullRadii()[v.pullRadius]));
 }
 
+TEST(Keys, SpeedPanelHelpSaveAndPause) {
+  ViewerState v;
+  EXPECT_EQ(handleKey(v, '>').command, Command::Speed);
+  EXPECT_EQ(v.speed, 2.0);
+  for (int i = 0; i < 20; ++i) handleKey(v, '<');
+  EXPECT_EQ(v.speed, kMinSpeed);  // bounded
+  for (int i = 0; i < 40; ++i) handleKey(v, '>');
+  EXPECT_EQ(v.speed, kMaxSpeed);
+  const bool panel = v.showPanel;
+  handleKey(v, 'm');
+  EXPECT_NE(v.showPanel, panel);
+  handleKey(v, '?');
+  EXPECT_TRUE(v.showHelp);
+  EXPECT_EQ(handleKey(v, 'w').command, Command::SaveWorld);
+  EXPECT_EQ(handleKey(v, 'p').command, Command::Pause);
+  EXPECT_TRUE(v.paused);
+}
+
 TEST(Keys, TheTableNamesEveryKey) {
   const std::string table = keyTable();
-  for (const char* key : {"ESC", "space", "1-9", "+ -", "[ ]", "s h b", " v ", " p ", " r ", " f ",
-                          " g ", " e ", "z x", " i ", " . "}) {
+  for (const char* key :
+       {"ESC", "space", "1-9", "+ -", "[ ]", "s h b", " v ", " p ", " r ", " f ",
+        " g ", " e ",   "z x", " i ", " . ", "< >",   " m ", " ? ", " w ", "middle-drag"}) {
     EXPECT_NE(("\n" + table).find(std::string(key).substr(key[0] == ' ')), std::string::npos)
         << key;
   }

@@ -54,6 +54,11 @@ void writeJpeg(const std::filesystem::path& path, const Image& image, int qualit
 
 Image readImage(const std::filesystem::path& path) {
   int width = 0, height = 0, channels = 0;
+  // Refused before decoding: a huge image would allocate gigabytes.
+  if (stbi_info(path.c_str(), &width, &height, &channels) && (width > 16384 || height > 16384)) {
+    throw std::runtime_error(path.string() + ": image of " + std::to_string(width) + "x" +
+                             std::to_string(height) + " pixels is too large (16384 at most)");
+  }
   std::unique_ptr<stbi_uc, void (*)(void*)> pixels(
       stbi_load(path.c_str(), &width, &height, &channels, 3), stbi_image_free);
   if (!pixels) {

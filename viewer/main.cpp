@@ -13,6 +13,7 @@
 #include "solvers/solver_threads.h"
 #include "src/finite_options.h"
 #include "src/world_reader.h"
+#include "viewer/texture.h"
 #include "viewer/viewer_app.h"
 #include "viewer/viewer_state.h"
 
@@ -73,6 +74,9 @@ int main(int argc, char** argv) {
       ->excludes("--panel");
   app.add_flag("--wireframe", opt.wireframe, "Start in wireframe mode");
   app.add_flag("--field", opt.field, "Start with the force-field arrows shown (key f)");
+  app.add_option("--texture", opt.texture,
+                 "Texture the shaded cube from the start with this image (JPEG or PNG), or with "
+                 "'builtin' (key t toggles; without it, t shows the built-in texture)");
   app.add_flag("!--no-hud", opt.hud, "Hide the heads-up line");
   app.add_option("--benchmark", opt.benchmarkFrames,
                  "Draw this many frames as fast as possible, print frames/s and exit")
@@ -115,6 +119,13 @@ int main(int argc, char** argv) {
     }
   }
   if (panel || noPanel) opt.panel = panel;
+  if (!opt.texture.empty() && opt.texture != "builtin") {
+    try {
+      (void)jello::viewer::loadTexture(opt.texture);
+    } catch (const std::exception& e) {
+      return usageError(std::string("--texture: ") + e.what());
+    }
+  }
   if (!compare.empty()) {
     std::stringstream list(compare);
     for (std::string name; std::getline(list, name, ',');) {

@@ -40,22 +40,50 @@ void drawBox() {
   glEnd();
 }
 
+// Uploads `image` as the current 2D texture when it is not the one uploaded last.
+void bindTexture(const Image& image) {
+  static GLuint name = 0;
+  static const std::uint8_t* uploaded = nullptr;
+  if (name == 0) glGenTextures(1, &name);
+  glBindTexture(GL_TEXTURE_2D, name);
+  if (uploaded == image.rgb.data()) return;
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB, image.width, image.height, 0, GL_RGB, GL_UNSIGNED_BYTE,
+               image.rgb.data());
+  uploaded = image.rgb.data();
+}
+
 void drawShadedCube(const Scene& scene) {
   const std::vector<Vec3> normals = vertexNormals(*scene.mesh, *scene.state);
   glEnable(GL_LIGHTING);
-  const GLfloat diffuse[] = {0.85f, 0.18f, 0.28f, 1.0f}, specular[] = {0.5f, 0.5f, 0.5f, 1.0f};
-  glMaterialfv(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE, diffuse);
+  const bool textured = scene.texture != nullptr && !scene.texture->rgb.empty();
+  // Textured, the material is white and the texture gives the colour (GL_MODULATE).
+  const GLfloat red[] = {0.85f, 0.18f, 0.28f, 1.0f}, white[] = {1.0f, 1.0f, 1.0f, 1.0f},
+                specular[] = {0.5f, 0.5f, 0.5f, 1.0f};
+  glMaterialfv(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE, textured ? white : red);
   glMaterialfv(GL_FRONT_AND_BACK, GL_SPECULAR, specular);
   glMaterialf(GL_FRONT_AND_BACK, GL_SHININESS, 40.0f);
+  if (textured) {
+    bindTexture(*scene.texture);
+    glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+    glEnable(GL_TEXTURE_2D);
+  }
   glBegin(GL_TRIANGLES);
-  for (const auto& t : scene.mesh->triangles) {
-    for (int p : t) {
-      const Vec3& n = normals[p];
+  for (std::size_t i = 0; i < scene.mesh->triangles.size(); ++i) {
+    const auto& t = scene.mesh->triangles[i];
+    for (int c = 0; c < 3; ++c) {
+      const Vec3& n = normals[t[c]];
       glNormal3d(n.x, n.y, n.z);
-      vertex(scene.state->position(p));
+      if (textured) glTexCoord2f(scene.mesh->uv[i][c][0], scene.mesh->uv[i][c][1]);
+      vertex(scene.state->position(t[c]));
     }
   }
   glEnd();
+  if (textured) glDisable(GL_TEXTURE_2D);
   glDisable(GL_LIGHTING);
 }
 

@@ -11,6 +11,7 @@
 #include "src/world.h"
 #include "viewer/box_geometry.h"
 #include "viewer/camera.h"
+#include "viewer/image_writer.h"
 #include "viewer/surface.h"
 #include "viewer/viewer_state.h"
 
@@ -28,6 +29,7 @@ struct Scene {
   std::optional<std::pair<Vec3, Vec3>> pull;     // picked point and its target, while pulling
   double pullRadius = 0.0;                       // m, the pull's fall-off radius (rest length)
   std::optional<std::pair<Vec3, Vec3>> push;     // from the cube's centre along the push
+  const Image* texture = nullptr;                // shaded cube textured with it (key t)
 };
 
 struct Overlay {

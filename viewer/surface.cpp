@@ -33,12 +33,19 @@ SurfaceMesh surfaceMesh(const Lattice& lattice) {
       for (int a = 0; a + 1 < n; ++a) {
         for (int b = 0; b + 1 < n; ++b) {
           const int p00 = at(a, b), p10 = at(a + 1, b), p11 = at(a + 1, b + 1), p01 = at(a, b + 1);
+          const auto uv = [n](int i) { return static_cast<float>(i) / static_cast<float>(n - 1); };
+          const std::array<float, 2> t00{uv(a), uv(b)}, t10{uv(a + 1), uv(b)},
+              t11{uv(a + 1), uv(b + 1)}, t01{uv(a), uv(b + 1)};
           if (outwardPositive) {
             mesh.triangles.push_back({p00, p10, p11});
             mesh.triangles.push_back({p00, p11, p01});
+            mesh.uv.push_back({t00, t10, t11});
+            mesh.uv.push_back({t00, t11, t01});
           } else {
             mesh.triangles.push_back({p00, p11, p10});
             mesh.triangles.push_back({p00, p01, p11});
+            mesh.uv.push_back({t00, t11, t10});
+            mesh.uv.push_back({t00, t01, t11});
           }
         }
       }

@@ -17,6 +17,9 @@ struct SurfaceMesh {
   int n = 0;                                  // points per axis
   std::vector<int> points;                    // lattice indices of the surface points
   std::vector<std::array<int, 3>> triangles;  // lattice indices, outward winding at rest
+  // Texture coordinates of each triangle's corners: the face's two free lattice indices over
+  // N - 1, so each face of the cube shows the whole texture once.
+  std::vector<std::array<std::array<float, 2>, 3>> uv;
 };
 
 bool onSurface(const Lattice& lattice, int index);

@@ -17,6 +17,7 @@
 #include "viewer/renderer.h"
 #include "viewer/runner_group.h"
 #include "viewer/sim_runner.h"
+#include "viewer/texture.h"
 #include "viewer/viewer_state.h"
 
 namespace jello::viewer {
@@ -68,6 +69,10 @@ class Viewer {
     view_.mode = options.wireframe ? DisplayMode::Wireframe : DisplayMode::Shaded;
     view_.showHud = options.hud;
     view_.showField = options.field;
+    // --texture FILE (checked by main() already) or builtin; t toggles either.
+    const bool file = !options.texture.empty() && options.texture != "builtin";
+    texture_ = file ? loadTexture(options.texture) : builtinTexture();
+    view_.texture = !options.texture.empty();
     view_.showPanel = options.panel.value_or(!recording());  // recordings: the scene alone
     view_.speed = options.speed;
     frames_.resize(group_ ? group_->size() : 1);
@@ -139,6 +144,7 @@ class Viewer {
   std::unique_ptr<SimRunner> single_;
   std::unique_ptr<RunnerGroup> group_;
   Panel panel_;
+  Image texture_;
   std::vector<Frame> frames_;
   // The first (or only) runner's frame: the heads-up, the panel and picking use it.
   Frame& primary() { return frames_.front(); }
@@ -229,6 +235,7 @@ Scene Viewer::scene(std::size_t pane) const {
   s.mesh = &g.mesh;
   s.springs = &g.springs;
   s.arrows = &g.arrows;
+  if (view_.texture) s.texture = &texture_;
   if (f.pull) {
     s.pull = std::pair(f.state.position(f.pull->first), f.pull->second);
     s.pullRadius = pullRadius();

@@ -22,10 +22,11 @@ struct ViewerOptions {
   std::filesystem::path recordDir;  // non-empty: record `frames` frames and exit
   int frames = 0;
   Viewport size;
-  double speed = 1.0;       // playback: simulated seconds per wall second
-  bool courseTime = false;  // the original pacing: the world's n*dt per displayed frame
-  bool wireframe = false;   // start in wireframe
-  bool field = false;       // start with the field arrows shown
+  double speed = 1.0;             // playback: simulated seconds per wall second
+  bool courseTime = false;        // the original pacing: the world's n*dt per displayed frame
+  bool wireframe = false;         // start in wireframe
+  bool field = false;             // start with the field arrows shown
+  std::filesystem::path texture;  // non-empty: this image ("builtin": ours) from the start
   bool hud = true;
   std::optional<bool> panel;            // unset: shown interactively, hidden in recordings
   std::vector<IntegratorKind> compare;  // 2-6: these integrators side by side

@@ -34,10 +34,10 @@ KeyResult handleKey(ViewerState& s, unsigned char key) {
       s.camera = Camera{};
       break;
     case 'z':
-      s.camera.zoom(-0.2);
+      s.camera.zoomBy(0.9);  // 10% per press, as one wheel notch
       break;
     case 'x':
-      s.camera.zoom(0.2);
+      s.camera.zoomBy(1.0 / 0.9);
       break;
     case 'v':
       s.mode = s.mode == DisplayMode::Shaded ? DisplayMode::Wireframe : DisplayMode::Shaded;
@@ -67,6 +67,9 @@ KeyResult handleKey(ViewerState& s, unsigned char key) {
       break;
     case '?':
       s.showHelp = !s.showHelp;
+      break;
+    case 't':
+      s.texture = !s.texture;
       break;
     case 'f':
       s.showField = !s.showField;
@@ -126,6 +129,7 @@ std::span<const KeyBinding> keyBindings() {
       {"middle-drag", "pan the camera"},
       {"e", "reset the camera"},
       {"v", "wireframe/shaded"},
+      {"t", "texture on the shaded cube on/off (--texture FILE, else a built-in one)"},
       {"s h b", "wireframe: structural, shear, bend springs on/off"},
       {"p", "pause/resume"},
       {".", "advance one frame (the world's n*dt) while paused"},

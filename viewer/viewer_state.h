@@ -29,6 +29,7 @@ struct ViewerState {
   double speed = 1.0;      // playback: simulated seconds per wall second (real time)
   bool showPanel = true;   // the ImGui panel
   bool showHelp = false;   // the key table on screen
+  bool texture = false;    // the shaded cube textured
 };
 
 inline constexpr double kMinSpeed = 1.0 / 1024, kMaxSpeed = 64.0;
