@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   cmake ninja-build g++ pkg-config
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread libsundials-dev
-  freeglut3-dev libgl1-mesa-dev libglu1-mesa-dev xvfb xauth libstb-dev
+  freeglut3-dev libgl1-mesa-dev libglu1-mesa-dev xvfb xauth libstb-dev libimgui-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libspectra-dev libcli11-dev nlohmann-json3-dev gnuplot-nox
   clang-14 libclang-rt-14-dev clang-format-14
