@@ -159,6 +159,19 @@ TEST(SimRunner, PanelEditsReachTheModel) {
   EXPECT_NEAR(after.energy.spring, 3.0 * before.energy.spring, 1e-9 * before.energy.spring);
   EXPECT_EQ(after.state.x, before.state.x);  // the state is kept
   EXPECT_EQ(after.integrator, before.integrator);
+  // The solver section: an integrator started afresh with the panel's settings.
+  SolverOptions options = after.solverOptions;
+  options.implicit.newtonTolerance = 1e-6;
+  options.implicit.linearSolver = LinearSolverKind::Cg;
+  runner.post([options](ViewerSession& s) {
+    s.simulation().setIntegrator(IntegratorKind::Implicit, options);
+  });
+  runner.sync();
+  const Frame solver = runner.frame();
+  EXPECT_EQ(solver.integrator, IntegratorKind::Implicit);
+  EXPECT_EQ(solver.solverOptions.implicit.newtonTolerance, 1e-6);
+  EXPECT_EQ(solver.solverOptions.implicit.linearSolver, LinearSolverKind::Cg);
+  EXPECT_EQ(solver.state.x, before.state.x);
 }
 
 TEST(SimRunner, ACommandThatFailsBecomesAnAlarmNotAStop) {

@@ -185,6 +185,75 @@ void Panel::constants(const Frame& frame, SimRunner& runner) {
   }
 }
 
+// The settings of the running integrator (jello-sim's solver flags), applied by starting it
+// afresh with them on the same state: combos and check boxes at once, sliders when released.
+// While nothing is being edited, the panel's copy follows the simulation's.
+void Panel::solverOptions(const Frame& frame, SimRunner& runner) {
+  if (!ImGui::IsAnyItemActive()) {
+    options_ = frame.solverOptions;
+    newtonTolerance_ = static_cast<float>(options_.implicit.newtonTolerance);
+    rtol_ = static_cast<float>(options_.cvode.rtol);
+  }
+  SolverOptions& o = options_;
+  bool changed = false;
+  const auto released = [] { return ImGui::IsItemDeactivatedAfterEdit(); };
+  const auto linearSolver = [&](LinearSolverKind& solver, PreconditionerKind& preconditioner) {
+    int k = static_cast<int>(solver);
+    changed |= ImGui::Combo("linear solver", &k, "cholmod\0ldlt\0cg\0");
+    solver = static_cast<LinearSolverKind>(k);
+    if (solver == LinearSolverKind::Cg) {
+      int p = static_cast<int>(preconditioner);
+      changed |= ImGui::Combo("preconditioner", &p, "jacobi\0block-jacobi\0ichol\0factor\0");
+      preconditioner = static_cast<PreconditionerKind>(p);
+    }
+  };
+  switch (frame.integrator) {
+    case IntegratorKind::Implicit:
+    case IntegratorKind::ImplicitLinear:
+    case IntegratorKind::Midpoint:
+    case IntegratorKind::Newmark:
+    case IntegratorKind::Bdf2:
+      linearSolver(o.implicit.linearSolver, o.implicit.preconditioner);
+      if (logSlider("newton tol", &newtonTolerance_, 1e-12f, 1e-2f, "%.1e")) {
+        o.implicit.newtonTolerance = newtonTolerance_;
+        changed = true;
+      }
+      ImGui::SliderInt("newton iters", &o.implicit.newtonMaxIterations, 1, 100);
+      changed |= released();
+      changed |= ImGui::Checkbox("keep factor", &o.implicit.reuseFactor);
+      break;
+    case IntegratorKind::Cvode: {
+      int method = static_cast<int>(o.cvode.method);
+      changed |= ImGui::Combo("method", &method, "bdf\0adams\0");
+      o.cvode.method = static_cast<CvodeMethod>(method);
+      if (logSlider("rtol", &rtol_, 1e-10f, 1e-1f, "%.1e")) {
+        o.cvode.rtol = rtol_;
+        changed = true;
+      }
+      ImGui::SliderInt("max order", &o.cvode.maxOrder, 1, 5);
+      changed |= released();
+      if (o.cvode.method == CvodeMethod::Bdf) {
+        changed |= ImGui::Checkbox("krylov (SPGMR)", &o.cvode.krylov);
+        linearSolver(o.cvode.linearSolver, o.cvode.preconditioner);
+      }
+      changed |= ImGui::Checkbox("contact roots", &o.cvode.contactRoots);
+      break;
+    }
+    case IntegratorKind::Projective:
+      ImGui::SliderInt("iterations", &o.projective.iterations, 1, 200);
+      changed |= released();
+      break;
+    default:
+      ImGui::TextUnformatted("(explicit: no solver settings)");
+      return;
+  }
+  if (changed && !frame.divergence) {
+    runner.post([kind = frame.integrator,
+                 o](ViewerSession& session) { session.simulation().setIntegrator(kind, o); },
+                true);
+  }
+}
+
 void Panel::plots(const Frame& frame) {
   const auto plot = [&](int series, const char* overlay) {
     const auto& v = history_.values[series];
@@ -256,6 +325,7 @@ void Panel::build(const Frame& frame, ViewerState& view, SimRunner& runner) {
     }
     ImGui::Text("t %.3f s  %ld steps", frame.state.t, frame.steps);
     ImGui::Text("%.3g simulated s per wall s%s", frame.simRate, frame.lagging ? " (behind)" : "");
+    if (ImGui::CollapsingHeader("solver")) solverOptions(frame, runner);
     if (ImGui::CollapsingHeader("world")) constants(frame, runner);
     if (ImGui::CollapsingHeader("pull")) {
       ImGui::Checkbox("pull mode (g)", &view.pullMode);

@@ -63,6 +63,7 @@ class Panel {
   void syncFromWorld(const Frame& frame);
   void constants(const Frame& frame, SimRunner& runner);
   void plots(const Frame& frame);
+  void solverOptions(const Frame& frame, SimRunner& runner);
 
   PlotHistory history_;
   long generation_ = -1;
@@ -70,6 +71,8 @@ class Panel {
   float k_ = 0, d_ = 0, kCollision_ = 0, dCollision_ = 0, mass_ = 0, fieldScale_ = 1;
   float dt_ = 0;
   float pullScale_ = 1;
+  SolverOptions options_;  // the solver section's copy while editing
+  float newtonTolerance_ = 1e-8f, rtol_ = 1e-6f;
   std::optional<Plane> savedPlane_;
   std::optional<Sphere> savedSphere_;
   bool plane_ = false, sphere_ = false;

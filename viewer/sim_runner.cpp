@@ -182,6 +182,7 @@ void SimRunner::publish(std::unique_lock<std::mutex>& lock) {
   f.energy = energyReport(sim);
   f.angularMomentum = sim.model().angularMomentum(sim.state());
   f.solver = sim.integrator().statistics();
+  f.solverOptions = sim.solverOptions();
   if (sim.divergence()) f.divergence = sim.divergence()->describe();
   f.pull = session_.pulling();
   const double wall = now();

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "solvers/integrator.h"
+#include "solvers/solver_options.h"
 #include "viewer/viewer_session.h"
 
 namespace jello::viewer {
@@ -47,6 +48,7 @@ struct Frame {
   EnergyReport energy;
   Vec3 angularMomentum;
   std::vector<Statistic> solver;  // the integrator's counters
+  SolverOptions solverOptions;    // the integrator's settings
   std::optional<std::string> divergence;
   std::optional<std::pair<int, Vec3>> pull;  // picked point and target while pulling
   double speed = 1.0;
