@@ -17,7 +17,7 @@ namespace jello {
 
 // A state has diverged when any value is not finite or a point is farther than
 // kDivergenceBound from the origin (m: the box is [-2,2]^3, so no sane state comes near it).
-inline constexpr double kDivergenceBound = 100.0;
+inline constexpr double kDivergenceBound = kStartBound;
 // A run has diverged, too, when its energy has grown: kinetic + spring + contact energy minus
 // the work the field and the user force have done exceeds the budget, kEnergyGrowthFactor times
 // its start plus kEnergyFloor (J, so that a cube starting at rest is not flagged by round-off),

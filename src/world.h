@@ -59,7 +59,10 @@ struct ForceField {
   bool empty() const { return resolution == 0; }
 };
 
-inline constexpr int kDefaultCubeResolution = 8;  // the only one the original format knows
+inline constexpr int kDefaultCubeResolution = 8;
+// m: no point may start farther from the origin (the box is [-2,2]^3). The simulation's
+// divergence bound (solvers/simulation.h) is the same distance.
+inline constexpr double kStartBound = 100.0;  // the only one the original format knows
 
 struct World {
   IntegratorKind integrator = IntegratorKind::RK4;

@@ -1,11 +1,14 @@
 #include "src/world_reader.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <sstream>
 #include <system_error>
+#include <tuple>
 #include <vector>
 
 namespace jello {
@@ -106,6 +109,12 @@ class Tokenizer {
   int line_ = 1;
   Token lastToken_;
 };
+
+std::string metres(double value) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", value);
+  return buf;
+}
 
 bool isExtensionKeyword(std::string_view s) {
   return s == "integrator" || s == "cube" || s == "sphere" || s == "cone" || s == "spiral";
@@ -353,6 +362,38 @@ World parseWorld(std::string_view text, const std::string& name, const ReaderLim
     w.positions[p] = {values[3 * p], values[3 * p + 1], values[3 * p + 2]};
     const std::size_t q = 3 * (points + p);
     w.velocities[p] = {values[q], values[q + 1], values[q + 2]};
+    // A start the simulation would call diverged at once is refused here, naming its line.
+    const Vec3& x = w.positions[p];
+    if (std::hypot(x.x, x.y, x.z) > kStartBound) {
+      in.fail(tokens[3 * p], "point " + std::to_string(p) + " starts " +
+                                 metres(std::hypot(x.x, x.y, x.z)) +
+                                 " m from the origin (at most " + metres(kStartBound) +
+                                 " m: the box is [-2,2]^3)");
+    }
+    const Vec3& v = w.velocities[p];
+    if (!std::isfinite(0.5 * w.mass * (v.x * v.x + v.y * v.y + v.z * v.z))) {
+      in.fail(tokens[q],
+              "point " + std::to_string(p) + "'s velocity gives it an infinite kinetic energy");
+    }
+  }
+  // Two points at one place: the springs between them would have no direction (0/0).
+  std::vector<std::size_t> order(points);
+  for (std::size_t p = 0; p < points; ++p) order[p] = p;
+  const auto key = [&](std::size_t p) {
+    const Vec3& x = w.positions[p];
+    return std::tuple(x.x, x.y, x.z);
+  };
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return key(a) < key(b) || (key(a) == key(b) && a < b);
+  });
+  for (std::size_t i = 1; i < points; ++i) {
+    const std::size_t a = order[i - 1], b = order[i];
+    if (key(a) == key(b)) {
+      in.fail(tokens[3 * b], "points " + std::to_string(a) + " (line " +
+                                 std::to_string(tokens[3 * a].line) + ") and " + std::to_string(b) +
+                                 " start at the same position: the springs between them would "
+                                 "have no direction");
+    }
   }
   return w;
 }

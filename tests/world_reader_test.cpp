@@ -224,7 +224,15 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"UnknownIntegratorExtension", 0, "", 0, "integrator Verlet\n", 1040, "Verlet",
                  "unknown integrator"},
         BadInput{"IntegratorExtensionWithoutName", 0, "", 0, "integrator\n", 1041, "<end of file>",
-                 "integrator name was expected"}),
+                 "integrator name was expected"},
+        BadInput{"StartsFarAway", 20, "150 0 0", 0, "", 20, "150", "m from the origin"},
+        BadInput{"InfiniteKineticEnergy", 530, "1e200 0 0", 0, "", 530, "1e200",
+                 "infinite kinetic energy"},
+        BadInput{"CoincidentPoints", 17, "0 0 0", 0, "", 17, "0", "start at the same position"},
+        BadInput{"ConeWithZeroAxis", 0, "", 0, "cone 0 0 0 0 0 0 1 1\n", 1040, "0",
+                 "axis must not be zero"},
+        BadInput{"SpiralThickerThanItsPitch", 0, "", 0, "spiral 0 0 1 0.5 1.5 0.2 1 0.3\n", 1040,
+                 "0.3", "less than its pitch"}),
     [](const auto& param_info) { return param_info.param.name; });
 
 TEST(WorldReader, RefusesAHugeCubeBeforeAllocating) {
