@@ -155,6 +155,21 @@ TEST(JelloSim, StopsCleanlyOnSigintAndWritesNoWorld) {
   EXPECT_EQ(csv.back(), '\n');
 }
 
+TEST(JelloSim, SighupStopsLikeSigtermAndTheProgressLineIsTimeBased) {
+  // SIGHUP (the terminal closed) ends the run with its statistics, exit 128 + 1. The steps
+  // here take about 0.4 s each: a progress line appears anyway (it used to wait for 256 steps).
+  test::TempDir dir;
+  const auto stats = dir.path() / "s.json";
+  const Outcome r = run("timeout --preserve-status -s HUP 5 " + sim() + " " + world("jello.w") +
+                        " --integrator projective --dt 0.01 --time 100 --projective-iters 2000"
+                        " --stats " +
+                        stats.string());
+  EXPECT_EQ(r.code, 129) << r.output;
+  EXPECT_TRUE(contains(r.output, "interrupted (signal 1)")) << r.output;
+  EXPECT_EQ(nlohmann::json::parse(test::readFile(stats))["interrupted"], true);
+  EXPECT_TRUE(contains(r.output, "projective steps")) << r.output;  // the progress line
+}
+
 TEST(JelloSim, SigtermInsideOneLongStepStopsWithinASecond) {
   // One output interval of cvode (--dt 5, rtol 1e-9) on the stiff cube takes minutes, and so
   // does one projective step of 100,000 iterations: SIGTERM after one second must stop either

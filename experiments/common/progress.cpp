@@ -11,14 +11,16 @@ Progress::Progress(bool enabled, std::string label)
       label_(std::move(label)),
       tty_(::isatty(STDERR_FILENO) == 1),
       start_(std::chrono::steady_clock::now()),
-      last_(start_) {}
+      last_(start_),
+      lastTick_(start_) {}
 
 void Progress::draw(long done, long total) {
   using namespace std::chrono;
   const auto now = steady_clock::now();
   const double elapsed = duration<double>(now - start_).count();
   const double sinceLast = duration<double>(now - last_).count();
-  if (elapsed < 1.0 || sinceLast < (tty_ ? 0.5 : 5.0)) return;
+  // The first line after a second, then every half second (terminal) or 5 s (a log).
+  if (elapsed < 1.0 || (drawn_ && sinceLast < (tty_ ? 0.5 : 5.0))) return;
   last_ = now;
   const double fraction = total > 0 ? double(done) / double(total) : 0.0;
   const double eta = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
@@ -31,6 +33,18 @@ void Progress::draw(long done, long total) {
     return;
   }
   drawn_ = true;
+}
+
+void Progress::tick(long done, long total) {
+  using namespace std::chrono;
+  const auto now = steady_clock::now();
+  const double since = duration<double>(now - lastTick_).count();
+  // Aim at a clock reading every 5-50 ms.
+  if (since < 0.005 && stride_ < 65536) stride_ *= 2;
+  if (since > 0.05 && stride_ > 1) stride_ /= 2;
+  lastTick_ = now;
+  calls_ = 0;
+  draw(done, total);
 }
 
 void Progress::finish() {

@@ -2,7 +2,7 @@
 //   jello-sim WORLD [--integrator NAME] [--dt S] [--time S | --steps N] [--cube N]
 //             [--out FILE.w] [--trace FILE.csv --every K] [--stats FILE.json] [--quiet]
 // Exit codes: 0 done, 1 bad input or an I/O failure, 2 bad usage, 3 the simulation diverged,
-// 128 + signal when interrupted by SIGINT or SIGTERM (it stops at a step boundary).
+// 128 + signal when interrupted by SIGINT, SIGTERM or SIGHUP (it stops at a step boundary).
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
@@ -167,8 +167,9 @@ int run(const Options& opt) {
   jello::Progress progress(!opt.quiet, name + " steps");
   const auto t0 = std::chrono::steady_clock::now();
   bool diverged = false;
-  jello::setSignalHandler("jello-sim", SIGINT, onInterrupt);
-  jello::setSignalHandler("jello-sim", SIGTERM, onInterrupt);
+  // SIGHUP (the terminal closed) stops like SIGTERM: the stats and the trace are written.
+  for (int signo : {SIGINT, SIGTERM, SIGHUP})
+    jello::setSignalHandler("jello-sim", signo, onInterrupt);
   for (long i = 0; i < total && interruptSignal == 0; ++i) {
     if (const jello::StepResult r = sim.step(); !r.ok) {
       diverged = !r.interrupted;  // a stop inside a step leaves the state at its start
@@ -178,8 +179,7 @@ int run(const Options& opt) {
     progress.update(i + 1, total);
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  jello::setSignalHandler("jello-sim", SIGINT, SIG_DFL);
-  jello::setSignalHandler("jello-sim", SIGTERM, SIG_DFL);
+  for (int signo : {SIGINT, SIGTERM, SIGHUP}) jello::setSignalHandler("jello-sim", signo, SIG_DFL);
   const int interrupted = interruptSignal;
   progress.finish();
 
