@@ -3,175 +3,17 @@
 #include <GL/freeglut.h>
 #include <unistd.h>
 
-#include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <sstream>
 #include <thread>
 
-#include "viewer/image_writer.h"
 #include "viewer/interaction.h"
-#include "viewer/panel.h"
-#include "viewer/renderer.h"
-#include "viewer/runner_group.h"
-#include "viewer/sim_runner.h"
-#include "viewer/texture.h"
-#include "viewer/viewer_state.h"
+#include "viewer/viewer_window.h"
 
 namespace jello::viewer {
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-constexpr double kInteractiveFps = 60.0;  // interactive drawing is capped at this rate
-constexpr double kNoticeSeconds = 4.0, kAlarmSeconds = 8.0, kFadeSeconds = 1.0;
-
-std::string format(const char* fmt, double value) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, value);
-  return buf;
-}
-
-double seconds(Clock::duration d) {
-  return std::chrono::duration<double>(d).count();
-}
-
-// "jello-000.w", "jello-001.w", ...: the first that does not exist.
-std::optional<std::string> freeName(const char* pattern) {
-  for (int i = 0; i < 1000; ++i) {
-    char name[32];
-    std::snprintf(name, sizeof name, pattern, i);
-    if (!std::filesystem::exists(name)) return std::string(name);
-  }
-  return std::nullopt;
-}
-
-SimRunner::Options runnerOptions(const ViewerOptions& options) {
-  SimRunner::Options r;
-  const bool recording = !options.recordDir.empty();
-  r.pacing = recording || options.courseTime ? Pacing::Target : Pacing::RealTime;
-  r.speed = options.speed;
-  return r;
-}
-
-class Viewer {
- public:
-  Viewer(const ViewerOptions& options, World world) : options_(options), viewport_(options.size) {
-    if (options.compare.empty()) {
-      single_ =
-          std::make_unique<SimRunner>(options.source, std::move(world), runnerOptions(options));
-    } else {
-      group_ = std::make_unique<RunnerGroup>(options.source, world, options.compare,
-                                             runnerOptions(options));
-    }
-    view_.mode = options.wireframe ? DisplayMode::Wireframe : DisplayMode::Shaded;
-    view_.showHud = options.hud;
-    view_.showField = options.field;
-    // --texture FILE (checked by main() already) or builtin; t toggles either.
-    const bool file = !options.texture.empty() && options.texture != "builtin";
-    texture_ = file ? loadTexture(options.texture) : builtinTexture();
-    view_.texture = !options.texture.empty();
-    view_.showPanel = options.panel.value_or(!recording());  // recordings: the scene alone
-    view_.speed = options.speed;
-    frames_.resize(group_ ? group_->size() : 1);
-    for (std::size_t i = 0; i < frames_.size(); ++i) frames_[i] = runner(i).frame();
-    recordSpan_ =
-        recordedFrameSpan(options.speed, options.courseTime, primary().geometry->frameTime);
-    recordStart_ = primary().state.t;
-  }
-
-  void display();
-  void reshape(int w, int h) {
-    viewport_ = {std::max(w, 1), std::max(h, 1)};
-    panel_.reshape(w, h);
-  }
-  void key(unsigned char key);
-  void mouse(int button, int state, int x, int y);
-  void motion(int x, int y);
-  void idle();
-  void passiveMotion(int x, int y) {
-    panel_.passiveMotion(x, y);
-    if (view_.showPanel) glutPostRedisplay();
-  }
-  void keyUp(unsigned char c, int x, int y) { panel_.keyUp(c, x, y); }
-  void special(int key, int x, int y, bool down) {
-    panel_.special(key, x, y, down);
-    glutPostRedisplay();
-  }
-  int exitCode() const { return exitCode_; }
-
- private:
-  bool recording() const { return !options_.recordDir.empty(); }
-  void waitForRecordedFrame();
-  void capture(const std::filesystem::path& path);
-  void screenshot();
-  void notify(std::string message, bool alarm) {
-    message_ = std::move(message);
-    alarm_ = alarm;
-    messageTime_ = Clock::now();
-  }
-  void takeNotices();
-  Overlay overlay(std::size_t pane) const;
-  std::string hudLine(std::size_t pane) const;
-  Scene scene(std::size_t pane) const;
-  void leave(int code) {
-    exitCode_ = code;
-    glutLeaveMainLoop();
-  }
-  double pullRadius() const { return pullRadii()[static_cast<std::size_t>(view_.pullRadius)]; }
-  std::string restartHint() const;
-
-  ViewerOptions options_;
-  // The simulation: one runner, or one per integrator in compare mode.
-  SimRunner& runner(std::size_t i = 0) { return single_ ? *single_ : (*group_)[i]; }
-  std::size_t runnerCount() const { return group_ ? group_->size() : 1; }
-  template <class F>
-  void forEachRunner(F f) {
-    for (std::size_t i = 0; i < runnerCount(); ++i) f(runner(i));
-  }
-  void postAll(const std::function<void(ViewerSession&)>& command, bool urgent = false) {
-    forEachRunner([&](SimRunner& r) { r.post(command, urgent); });
-  }
-  double latestTime() const {
-    double t = frames_.front().state.t;
-    for (const Frame& f : frames_) t = std::max(t, f.state.t);
-    return t;
-  }
-  void drawPanes();
-
-  std::unique_ptr<SimRunner> single_;
-  std::unique_ptr<RunnerGroup> group_;
-  Panel panel_;
-  Image texture_;
-  std::vector<Frame> frames_;
-  // The first (or only) runner's frame: the heads-up, the panel and picking use it.
-  Frame& primary() { return frames_.front(); }
-  const Frame& primary() const { return frames_.front(); }
-  ViewerState view_;
-  Viewport viewport_;
-  std::string message_;
-  bool alarm_ = false;
-  Clock::time_point messageTime_ = Clock::now();
-  bool divergenceShown_ = false;
-  int exitCode_ = 0;
-  bool screenshotPending_ = false;
-  int framesDrawn_ = 0;
-  double recordSpan_ = 0.0, recordStart_ = 0.0;
-  long drawnPublished_ = -1;
-
-  enum class Drag { None, Rotate, Pan, Push, Pull } drag_ = Drag::None;
-  int lastX_ = 0, lastY_ = 0, pressX_ = 0, pressY_ = 0;
-  Vec3 anchor_;        // the picked point where the pull began: the drag plane goes through it
-  Viewport dragPane_;  // the pane the pull was picked in
-  double dragOffsetX_ = 0, dragOffsetY_ = 0;  // its top-left corner in the window
-  Vec3 pushAccel_;
-
-  Clock::time_point started_ = Clock::now(), rateWindow_ = Clock::now(), lastDraw_ = Clock::now();
-  int windowFrames_ = 0;
-  double fps_ = 0.0;
-};
+namespace window {
 
 std::string Viewer::restartHint() const {
   if (group_) return " - press r to reload the world for every pane";
@@ -418,162 +260,11 @@ void Viewer::screenshot() {
   }
 }
 
-void Viewer::key(unsigned char key) {
-  if (panel_.key(key, lastX_, lastY_)) return glutPostRedisplay();  // typing into the panel
-  const KeyResult result = handleKey(view_, key);
-  if (key == 'f' && view_.showField && primary().geometry->arrows.empty()) {
-    notify("this world has no force field (or it is zero everywhere): no arrows to draw", false);
-  }
-  switch (result.command) {
-    case Command::Quit:
-      return leave(0);
-    case Command::Screenshot:
-      screenshotPending_ = true;
-      break;
-    case Command::Reload: {
-      const std::string file = options_.source.world.string();
-      forEachRunner([&](SimRunner& r) {
-        r.post(
-            [&r, file](ViewerSession& s) {
-              if (std::optional<std::string> error = s.reload()) {
-                r.notify({"reload failed, scene kept: " + *error, true});
-              } else {
-                r.notify({"reloaded " + file, false});
-              }
-            },
-            true);
-      });
-      view_.dtScale = 1.0;
-      view_.paused = false;
-      forEachRunner([](SimRunner& r) { r.setPaused(false); });
-      if (group_) {  // a reload is quick: wait for it, and start the shared clock over
-        forEachRunner([](SimRunner& r) { r.sync(); });
-        group_->setTarget(runner().frame().state.t);
-        group_->setPaused(false);
-      }
-      drag_ = Drag::None;
-      break;
-    }
-    case Command::SwitchIntegrator:
-      if (group_) {
-        notify("compare mode: the integrators are the --compare list", true);
-        break;
-      }
-      if (primary().divergence) {
-        notify("the simulation diverged" + restartHint(), true);
-        break;
-      }
-      runner().post(
-          [kind = *result.integrator](ViewerSession& s) { s.simulation().setIntegrator(kind); },
-          true);
-      notify("integrator " + std::string(integratorName(*result.integrator)), false);
-      break;
-    case Command::TimeStep:
-      postAll([scale = view_.dtScale](ViewerSession& s) { s.scaleTimeStep(scale); }, true);
-      notify("time step x" + format("%.4g", view_.dtScale) + " of the world's", false);
-      break;
-    case Command::StepOnce:
-      if (view_.paused && group_) group_->advanceBy(primary().geometry->frameTime);
-      if (view_.paused && !group_) runner().stepFrame();
-      break;
-    case Command::Pause:
-      if (group_) {
-        group_->setPaused(view_.paused);
-      } else {
-        runner().setPaused(view_.paused);
-      }
-      break;
-    case Command::Speed:
-      if (group_) {
-        group_->setSpeed(view_.speed);
-      } else {
-        runner().setSpeed(view_.speed);
-      }
-      notify("playback speed " + format("%.4g", view_.speed) + "x" +
-                 (options_.courseTime ? " (ignored in course time)" : ""),
-             false);
-      break;
-    case Command::SaveWorld:
-      runner().post([&r = runner(), pane = group_ ? " (the first pane's)" : ""](ViewerSession& s) {
-        const std::optional<std::string> name = freeName("jello-%03d.w");
-        if (!name) throw std::runtime_error("jello-000.w ... jello-999.w all exist: not saved");
-        s.save(*name);
-        r.notify({std::string("saved the current state") + pane + " as " + *name, false});
-      });
-      break;
-    case Command::None:
-      break;
-  }
-  glutPostRedisplay();
-}
+}  // namespace window
 
-void Viewer::mouse(int button, int state, int x, int y) {
-  if (view_.showPanel && panel_.mouse(button, state, x, y)) return glutPostRedisplay();
-  lastX_ = pressX_ = x;
-  lastY_ = pressY_ = y;
-  if (button == 3 || button == 4) {  // freeglut reports the wheel as buttons 3 and 4
-    if (state == GLUT_DOWN) view_.camera.zoomBy(button == 3 ? 0.9 : 1.0 / 0.9);
-    return glutPostRedisplay();
-  }
-  if (state == GLUT_UP) {
-    if (drag_ == Drag::Push || drag_ == Drag::Pull) {
-      postAll([](ViewerSession& s) { s.release(); });
-    }
-    drag_ = Drag::None;
-    return;
-  }
-  if (button == GLUT_RIGHT_BUTTON) {
-    drag_ = Drag::Rotate;
-  } else if (button == GLUT_MIDDLE_BUTTON) {
-    drag_ = Drag::Pan;
-  } else if (button == GLUT_LEFT_BUTTON) {
-    const bool pull = view_.pullMode || (glutGetModifiers() & GLUT_ACTIVE_SHIFT);
-    if (!pull) {
-      drag_ = Drag::Push;
-      pushAccel_ = {};
-    } else {
-      // The pane under the cursor picks; every pane's cube is pulled at the same point.
-      const std::vector<Pane> panes = paneLayout(int(runnerCount()), viewport_);
-      const std::optional<PanePixel> at =
-          group_ ? paneAt(panes, viewport_, x, y) : PanePixel{0, double(x), double(y)};
-      if (!at) return;
-      dragPane_ = group_ ? panes[std::size_t(at->pane)].size : viewport_;
-      dragOffsetX_ = x - at->x;
-      dragOffsetY_ = y - at->y;
-      const Frame& f = frames_[std::size_t(at->pane)];
-      if (auto p = pickPoint(view_.camera, dragPane_, f.geometry->mesh, f.state, at->x, at->y)) {
-        drag_ = Drag::Pull;
-        anchor_ = f.state.position(*p);
-        postAll([p = *p, anchor = anchor_, r = pullRadius()](ViewerSession& s) {
-          s.pull(p, anchor, r);
-        });
-      }
-    }
-  }
-}
+namespace {
 
-void Viewer::motion(int x, int y) {
-  if (view_.showPanel && drag_ == Drag::None && panel_.motion(x, y)) return glutPostRedisplay();
-  if (drag_ == Drag::Rotate) view_.camera.rotate(x - lastX_, y - lastY_);
-  if (drag_ == Drag::Pan) view_.camera.pan(x - lastX_, y - lastY_, viewport_.height);
-  lastX_ = x;
-  lastY_ = y;
-  if (drag_ == Drag::Push) {
-    Vec3 a = screenDragToWorld(view_.camera, x - pressX_, y - pressY_) * kPushPerPixel;
-    if (norm(a) > kMaxPullAcceleration) a = a * (kMaxPullAcceleration / norm(a));
-    pushAccel_ = a;
-    postAll([a](ViewerSession& s) { s.push(a); });
-  } else if (drag_ == Drag::Pull) {
-    const Vec3 target =
-        dragTarget(view_.camera, dragPane_, x - dragOffsetX_, y - dragOffsetY_, anchor_);
-    postAll([target, r = pullRadius()](ViewerSession& s) {
-      if (auto pulled = s.pulling()) s.pull(pulled->first, target, r);
-    });
-  }
-  glutPostRedisplay();
-}
-
-Viewer* active = nullptr;  // GLUT's callbacks take no context pointer
+window::Viewer* active = nullptr;  // GLUT's callbacks take no context pointer
 
 }  // namespace
 
@@ -608,7 +299,7 @@ int runViewer(const ViewerOptions& options, World world) {
   }
   int exitCode = 0;
   {
-    Viewer viewer(options, std::move(world));
+    window::Viewer viewer(options, std::move(world));
     active = &viewer;
     initRenderer();
     glutDisplayFunc([] { active->display(); });
