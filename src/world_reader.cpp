@@ -328,8 +328,17 @@ World parseWorld(std::string_view text, const std::string& name, const ReaderLim
   std::vector<Token> tokens;
   values.reserve(6 * 512);
   tokens.reserve(6 * 512);
+  // The largest cube the limits allow bounds how many numbers can follow: refused at the first
+  // number beyond it, so a file of a billion numbers costs no more memory than that cube.
+  const std::size_t largest = static_cast<std::size_t>(limits.maxCubeResolution);
+  const std::size_t maxValues = 6 * largest * largest * largest;
   Token t = in.next();
   while (!t.text.empty() && !isExtensionKeyword(t.text)) {
+    if (values.size() == maxValues) {
+      in.fail(t, "more numbers than the positions and velocities of the largest cube allowed (" +
+                     std::to_string(largest) + "^3 points: " + std::to_string(maxValues) +
+                     " numbers)");
+    }
     if (completeCube(values.size()) && !looksNumeric(t.text)) {
       in.fail(t,
               "unknown trailing content after the velocities (extension keywords: integrator, "

@@ -170,6 +170,21 @@ TEST(JelloSim, SighupStopsLikeSigtermAndTheProgressLineIsTimeBased) {
   EXPECT_TRUE(contains(r.output, "projective steps")) << r.output;  // the progress line
 }
 
+TEST(JelloSim, RunningOutOfMemoryIsAClearErrorNotAnAbort) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer reserves more address space than the limit allows";
+#else
+  // A 64^3 cube's springs need about 200 MB: under a 130 MB address-space limit an allocation
+  // fails, in the model or in Eigen, and the program says so and exits 1 (it used to abort
+  // with an uncaught std::bad_alloc, exit 134).
+  const Outcome r = run("bash -c 'ulimit -v 130000; " + sim() + " " + world("jello.w") +
+                        " --cube 64 --steps 1 --quiet'");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "jello-sim: error: out of memory")) << r.output;
+  EXPECT_FALSE(contains(r.output, "terminate called")) << r.output;
+#endif
+}
+
 TEST(JelloSim, SigtermInsideOneLongStepStopsWithinASecond) {
   // One output interval of cvode (--dt 5, rtol 1e-9) on the stiff cube takes minutes, and so
   // does one projective step of 100,000 iterations: SIGTERM after one second must stop either

@@ -243,6 +243,29 @@ TEST(WorldReader, RefusesAHugeCubeBeforeAllocating) {
   EXPECT_THROW((void)parseWorld(join(lines), "big.w", limits), WorldFileError);
 }
 
+TEST(WorldReader, RefusesEndlessNumbersAtTheFirstOneNoCubeCouldHold) {
+  // A valid 2^3 world followed by a million numbers: with the cube limit at 16 (6 * 16^3 =
+  // 24,576 numbers), the reader stops at the first number past that bound, naming its line,
+  // instead of collecting all of them.
+  ReaderLimits limits;
+  limits.maxCubeResolution = 16;
+  World w = buildWorld(SceneSpec{});
+  std::string text = formatWorld(w);
+  for (int i = 0; i < 1000000; ++i) text += "1\n";
+  try {
+    (void)parseWorld(text, "endless.w", limits);
+    FAIL() << "accepted";
+  } catch (const WorldFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("more numbers than the positions and velocities"),
+              std::string::npos)
+        << e.what();
+    // The world's own 6 * 512 numbers and then one per line: the line of number 24,577.
+    const auto worldLines =
+        std::count(text.begin(), text.begin() + long(formatWorld(w).size()), '\n');
+    EXPECT_EQ(e.line(), worldLines + (6 * 16 * 16 * 16 - 6 * 512) + 1);
+  }
+}
+
 TEST(WorldReader, ReportsAMissingFile) {
   try {
     (void)readWorld("/nonexistent/dir/world.w");

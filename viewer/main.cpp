@@ -12,6 +12,7 @@
 
 #include "solvers/solver_threads.h"
 #include "src/finite_options.h"
+#include "src/out_of_memory.h"
 #include "src/world_reader.h"
 #include "viewer/texture.h"
 #include "viewer/viewer_app.h"
@@ -31,6 +32,7 @@ std::filesystem::path defaultWorld() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  jello::exitCleanlyWhenOutOfMemory("jello");
   jello::applySolverThreadSettings(argv);
   jello::viewer::ViewerOptions opt;
   std::string world = defaultWorld().string(), integrator, size = "640x480";

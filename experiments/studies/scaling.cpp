@@ -19,6 +19,7 @@
 #include "solvers/simulation.h"
 #include "solvers/solver_threads.h"
 #include "src/finite_options.h"
+#include "src/out_of_memory.h"
 #include "src/scene_builder.h"
 
 namespace {
@@ -43,6 +44,7 @@ double statistic(const Integrator& integrator, const std::string& name) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  jello::exitCleanlyWhenOutOfMemory("jello-scaling");
   jello::ignoreBrokenPipes("jello-scaling");
   applySolverThreadSettings(argv);
   std::vector<int> ns{8, 12, 16, 24, 32};

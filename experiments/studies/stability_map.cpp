@@ -17,6 +17,7 @@
 #include "solvers/simulation.h"
 #include "solvers/solver_threads.h"
 #include "src/finite_options.h"
+#include "src/out_of_memory.h"
 
 namespace {
 
@@ -49,6 +50,7 @@ struct Point {
 }  // namespace
 
 int main(int argc, char** argv) {
+  jello::exitCleanlyWhenOutOfMemory("jello-stability");
   jello::ignoreBrokenPipes("jello-stability");
   applySolverThreadSettings(argv);
   Options opt;

@@ -19,6 +19,7 @@
 #include "solvers/simulation.h"
 #include "solvers/solver_threads.h"
 #include "src/finite_options.h"
+#include "src/out_of_memory.h"
 #include "src/scene_builder.h"
 #include "src/world_reader.h"
 
@@ -86,6 +87,7 @@ struct Task {
 }  // namespace
 
 int main(int argc, char** argv) {
+  jello::exitCleanlyWhenOutOfMemory("jello-work-precision");
   jello::ignoreBrokenPipes("jello-work-precision");
   applySolverThreadSettings(argv);
   int levels = 7, jobs = int(std::max(1u, std::thread::hardware_concurrency()));

@@ -12,6 +12,7 @@
 #include "experiments/common/signal_handler.h"
 #include "src/atomic_file.h"
 #include "src/finite_options.h"
+#include "src/out_of_memory.h"
 #include "src/scene_builder.h"
 #include "src/world_reader.h"
 #include "src/world_writer.h"
@@ -29,6 +30,7 @@ Vec3 toVec3(const std::vector<double>& v) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  jello::exitCleanlyWhenOutOfMemory("jello-create-world");
   jello::ignoreBrokenPipes("jello-create-world");
   // A file-size limit fails the write (reported), not the process.
   jello::setSignalHandler("jello-create-world", SIGXFSZ, SIG_IGN);

@@ -23,6 +23,7 @@
 #include "src/atomic_file.h"
 #include "src/finite_options.h"
 #include "src/interrupt.h"
+#include "src/out_of_memory.h"
 #include "src/scene_builder.h"
 #include "src/world_reader.h"
 #include "src/world_writer.h"
@@ -277,6 +278,7 @@ int run(const Options& opt) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  jello::exitCleanlyWhenOutOfMemory("jello-sim");
   jello::ignoreBrokenPipes("jello-sim");
   jello::applySolverThreadSettings(argv);
   // A file-size limit (or a quota) must fail the write, which is reported and cleaned up, not

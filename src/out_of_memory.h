@@ -1,0 +1,49 @@
+// What every program does when memory runs out: a clear message and exit code 1, wherever the
+// allocation failed (a world's springs, a solver's factor, a table), instead of an uncaught
+// std::bad_alloc aborting with 134. Installed first thing in each main().
+#pragma once
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <new>
+
+namespace jello {
+
+namespace detail {
+inline const char* outOfMemoryProgram = "jello";
+inline void onOutOfMemory() {
+  // Only async-safe calls: the heap cannot be trusted now.
+  const char* p = outOfMemoryProgram;
+  const char msg[] =
+      ": error: out of memory (an allocation failed; try a smaller cube, field or grid, or a "
+      "higher memory limit)\n";
+  [[maybe_unused]] ssize_t a = ::write(STDERR_FILENO, p, std::strlen(p));
+  [[maybe_unused]] ssize_t b = ::write(STDERR_FILENO, msg, sizeof msg - 1);
+  std::_Exit(1);
+}
+
+// A std::bad_alloc nobody caught (Eigen and CHOLMOD's wrappers throw it without going through
+// operator new, so the new-handler never sees them) ends the same way.
+inline void onTerminate() {
+  if (const std::exception_ptr e = std::current_exception()) {
+    try {
+      std::rethrow_exception(e);
+    } catch (const std::bad_alloc&) {
+      onOutOfMemory();
+    } catch (...) {
+    }
+  }
+  std::abort();
+}
+}  // namespace detail
+
+inline void exitCleanlyWhenOutOfMemory(const char* program) {
+  detail::outOfMemoryProgram = program;
+  std::set_new_handler(detail::onOutOfMemory);
+  std::set_terminate(detail::onTerminate);
+}
+
+}  // namespace jello
