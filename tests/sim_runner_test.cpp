@@ -69,7 +69,7 @@ TEST(SimRunner, ASlowStepNeverDelaysTheRenderThread) {
 }
 
 TEST(SimRunner, QuittingCutsALongImplicitStepShort) {
-  // Backward Euler with one step of a whole second on the 16^3 cube: seconds of Newton work.
+  // CVODE with one output interval of 4 s on the 16^3 cube: minutes of work.
   World w = test::loadWorld("cube16.w");
   SimRunner::Options o;
   o.speed = 1.0;
@@ -78,9 +78,13 @@ TEST(SimRunner, QuittingCutsALongImplicitStepShort) {
   src.dt = 4.0;
   auto runner = std::make_unique<SimRunner>(src, w, o);
   std::this_thread::sleep_for(milliseconds(300));  // inside the first step
+  EXPECT_EQ(runner->frame().state.t, 0.0);         // which takes minutes uninterrupted
   const auto start = WallClock::now();
   runner.reset();
-  EXPECT_LT(secondsSince(start), 1.0);
+  // The interrupt is polled in every right-hand side; what cannot be cut short is one CHOLMOD
+  // factorization of the 12,288-unknown system (0.47 s in release, several times that under
+  // the sanitizers on a loaded machine).
+  EXPECT_LT(secondsSince(start), 5.0);
 }
 
 TEST(SimRunner, RealTimePlaybackAdvancesSpeedTimesWallTime) {

@@ -315,6 +315,12 @@ int runViewer(const ViewerOptions& options, World world) {
     glutMainLoop();
     active = nullptr;
     exitCode = viewer.exitCode();
+    // The window goes at once; the simulation thread may still finish a factorization (it
+    // cannot be cut short) while the viewer is taken down below.
+    if (glutGetWindow() == window) {
+      glutHideWindow();
+      glutMainLoopEvent();
+    }
   }  // the simulation thread stops here, a long step cut short
   // The window is still open when the loop returns after glutLeaveMainLoop: close it and let
   // freeglut release its state, so the GL driver's memory is freed before exit.
