@@ -8,4 +8,4 @@ preset=${1:-release}
 if [ ! -f "build/$preset/CMakeCache.txt" ] || [ -n "${JELLO_WERROR:-}" ]; then
   cmake --preset "$preset" ${JELLO_WERROR:+"-DJELLO_WERROR=$JELLO_WERROR"} >/dev/null
 fi
-cmake --build --preset "$preset" -j"$(nproc)"
+cmake --build --preset "$preset" -j"$(env -u OMP_NUM_THREADS -u OMP_THREAD_LIMIT nproc)"
