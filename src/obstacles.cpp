@@ -13,18 +13,10 @@ Vec3 at(const double* x, int n, int p) {
   return {x[p], x[n + p], x[2 * n + p]};
 }
 
-// A unit vector of `v`, scaled first so that huge or tiny components neither overflow nor
-// underflow.
-Vec3 unit(const Vec3& v) {
-  const double m = std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});
-  const Vec3 s = v * (1.0 / m);
-  return s * (1.0 / norm(s));
-}
-
 // Any unit vector perpendicular to unit d.
 Vec3 perpendicular(const Vec3& d) {
   const Vec3 a = std::abs(d.x) < 0.9 ? Vec3{1.0, 0.0, 0.0} : Vec3{0.0, 1.0, 0.0};
-  return unit(cross(d, a));
+  return unitVector(cross(d, a));
 }
 
 void setOuter(double* m, const Vec3& a, const Vec3& b, double s) {
@@ -36,7 +28,7 @@ void setOuter(double* m, const Vec3& a, const Vec3& b, double s) {
 }  // namespace
 
 std::optional<Penetration> conePenetration(const Cone& cone, const Vec3& x) {
-  const Vec3 d = unit(cone.axis);
+  const Vec3 d = unitVector(cone.axis);
   const Vec3 rel = x - cone.apex;
   const double h = dot(d, rel);
   if (!(h > 0.0 && h < cone.height)) return std::nullopt;
@@ -161,7 +153,7 @@ void ObstacleContact::accumulate(const double* x, const double* v, double* f, in
   for (int p = 0; p < n; ++p) {
     const std::optional<Penetration> q = penetration(at(x, n, p));
     if (!q) continue;
-    const Vec3 nrm = unit(q->gradient * -1.0);
+    const Vec3 nrm = unitVector(q->gradient * -1.0);
     const double vn = dot(nrm, at(v, n, p));
     const Vec3 force = q->gradient * (-k_.stiffness * q->depth) - nrm * (k_.damping * vn);
     f[p] += force.x;
@@ -187,7 +179,7 @@ void ObstacleContact::addJacobian(const double* x, int n, JacobianBlocks& out) c
     if (!out.clampCompression) {
       for (int i = 0; i < 9; ++i) K[i] -= k_.stiffness * q->depth * q->hessian[i];
     }
-    const Vec3 nrm = unit(q->gradient * -1.0);
+    const Vec3 nrm = unitVector(q->gradient * -1.0);
     setOuter(out.diagD + 9 * p, nrm, nrm, -k_.damping);
   }
 }

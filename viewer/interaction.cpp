@@ -3,7 +3,6 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <vector>
 
 namespace jello::viewer {
 
@@ -34,23 +33,19 @@ Eigen::VectorXd pullForce(const Lattice& lattice, const State& state, int picked
   const int n = lattice.n, count = lattice.numPoints();
   const auto rest = [&](int p) { return lattice.restPosition(p / (n * n), (p / n) % n, p % n); };
   const Vec3 origin = rest(picked);
-  std::vector<double> weights(static_cast<std::size_t>(count), 0.0);
-  double weightSum = 0.0;
-  for (int p = 0; p < count; ++p) {
-    double w = 1.0;
-    if (!std::isinf(radius) && p != picked) {
-      const double d = norm(rest(p) - origin);
-      w = d < radius ? 1.0 - d / radius : 0.0;
-    }
-    weights[static_cast<std::size_t>(p)] = w;
-    weightSum += w;
-  }
+  const auto weight = [&](int p) {
+    if (std::isinf(radius) || p == picked) return 1.0;
+    const double d = norm(rest(p) - origin);
+    return d < radius ? 1.0 - d / radius : 0.0;
+  };
+  double weightSum = 0.0;  // a second pass rather than a vector per step
+  for (int p = 0; p < count; ++p) weightSum += weight(p);
   Vec3 pull = (target - state.position(picked)) * spring.stiffness;
   const double total = norm(pull) * weightSum;
   if (total > spring.maxForce) pull = pull * (spring.maxForce / total);
   Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * count);
   for (int p = 0; p < count; ++p) {
-    const double w = weights[static_cast<std::size_t>(p)];
+    const double w = weight(p);
     if (w > 0.0) State::set(f, p, (pull - state.velocity(p) * spring.damping) * w);
   }
   return f;

@@ -24,6 +24,24 @@ void drawText(int x, int y, const std::string& text) {
 
 constexpr int kLineHeight = 16, kCharWidth = 8;
 
+// Draw in the pane's pixels (origin at its lower left) until endPixels().
+void beginPixels(const Viewport& viewport) {
+  glMatrixMode(GL_PROJECTION);
+  glPushMatrix();
+  glLoadIdentity();
+  glOrtho(0.0, viewport.width, 0.0, viewport.height, -1.0, 1.0);
+  glMatrixMode(GL_MODELVIEW);
+  glPushMatrix();
+  glLoadIdentity();
+}
+
+void endPixels() {
+  glPopMatrix();
+  glMatrixMode(GL_PROJECTION);
+  glPopMatrix();
+  glMatrixMode(GL_MODELVIEW);
+}
+
 // Lines of text on a translucent dark backing; `top` is the first line's baseline, from the
 // window's bottom (GL's window coordinates).
 void drawTextBlock(const Viewport& viewport, const std::vector<std::string>& lines, int x, int top,
@@ -33,13 +51,7 @@ void drawTextBlock(const Viewport& viewport, const std::vector<std::string>& lin
   for (const std::string& line : lines) longest = std::max(longest, line.size());
   const int w = static_cast<int>(longest) * kCharWidth + 8;
   const int h = static_cast<int>(lines.size()) * kLineHeight + 4;
-  glMatrixMode(GL_PROJECTION);
-  glPushMatrix();
-  glLoadIdentity();
-  glOrtho(0.0, viewport.width, 0.0, viewport.height, -1.0, 1.0);
-  glMatrixMode(GL_MODELVIEW);
-  glPushMatrix();
-  glLoadIdentity();
+  beginPixels(viewport);
   glEnable(GL_BLEND);
   glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   glColor4f(0.0f, 0.0f, 0.0f, 0.6f * alpha);
@@ -51,10 +63,7 @@ void drawTextBlock(const Viewport& viewport, const std::vector<std::string>& lin
     y -= kLineHeight;
   }
   glDisable(GL_BLEND);
-  glPopMatrix();
-  glMatrixMode(GL_PROJECTION);
-  glPopMatrix();
-  glMatrixMode(GL_MODELVIEW);
+  endPixels();
 }
 
 }  // namespace
@@ -67,13 +76,7 @@ void setOverlayOrigin(int x0, int y0) {
 // The field's colour scale at the bottom right: 0 N ... the strongest drawn force.
 void drawLegend(const Viewport& viewport, double strongest) {
   const int w = 120, h = 10, x = viewport.width - w - 16, y = 30;
-  glMatrixMode(GL_PROJECTION);
-  glPushMatrix();
-  glLoadIdentity();
-  glOrtho(0.0, viewport.width, 0.0, viewport.height, -1.0, 1.0);
-  glMatrixMode(GL_MODELVIEW);
-  glPushMatrix();
-  glLoadIdentity();
+  beginPixels(viewport);
   glEnable(GL_BLEND);
   glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   glColor4f(0.0f, 0.0f, 0.0f, 0.6f);
@@ -87,10 +90,7 @@ void drawLegend(const Viewport& viewport, double strongest) {
     glVertex2i(x + w * i / 16, y + h);
   }
   glEnd();
-  glPopMatrix();
-  glMatrixMode(GL_PROJECTION);
-  glPopMatrix();
-  glMatrixMode(GL_MODELVIEW);
+  endPixels();
   char label[48];
   std::snprintf(label, sizeof label, "%.3g N", strongest);
   glColor3f(0.92f, 0.92f, 0.92f);

@@ -152,11 +152,9 @@ void normal(const Vec3& n) {
 // Lit like the sphere, a warmer grey: the cone's lateral surface (per-vertex normals of the
 // slope) and its base disk, clipped to the box.
 void drawCone(const Cone& cone) {
-  const double am = std::max({std::abs(cone.axis.x), std::abs(cone.axis.y), std::abs(cone.axis.z)});
-  const Vec3 scaled = cone.axis * (1.0 / am);
-  const Vec3 d = scaled * (1.0 / norm(scaled));
-  const Vec3 a = std::abs(d.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
-  const Vec3 e1 = cross(d, a) * (1.0 / norm(cross(d, a))), e2 = cross(d, e1);
+  const Vec3 d = unitVector(cone.axis);
+  const Vec3 e1 = unitVector(cross(d, std::abs(d.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}));
+  const Vec3 e2 = cross(d, e1);
   const double H = cone.height, R = cone.radius, L = std::hypot(H, R);
   const Vec3 base = cone.apex + d * H;
   constexpr int kSlices = 64;
