@@ -1,0 +1,83 @@
+// PrefactoredCholesky (solvers/prefactored_cholesky.h): its own substitutions over CHOLMOD's
+// factor solve the system, for one to three right-hand sides, after refactoring with new
+// values, and refuse a matrix that is not positive definite.
+#include "solvers/prefactored_cholesky.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <vector>
+
+#include "src/model.h"
+#include "src/scene_builder.h"
+#include "tests/test_support.h"
+
+namespace jello {
+namespace {
+
+// diag + the springs' weighted Laplacian of a 6^3 jello cube, weights varied per spring.
+SparseMatrix laplacianSystem(const Model& model, double diagonal, double spread) {
+  std::vector<Eigen::Triplet<double, int>> entries;
+  const int n = model.numPoints();
+  for (int p = 0; p < n; ++p) entries.emplace_back(p, p, diagonal * (1.0 + 0.01 * p));
+  int i = 0;
+  for (const Spring& s : model.springs().springs()) {
+    const double w = s.stiffness * (1.0 + spread * ((i++ % 7) - 3));
+    entries.emplace_back(s.a, s.a, w);
+    entries.emplace_back(s.b, s.b, w);
+    entries.emplace_back(s.a, s.b, -w);
+    entries.emplace_back(s.b, s.a, -w);
+  }
+  SparseMatrix A(n, n);
+  A.setFromTriplets(entries.begin(), entries.end());
+  A.makeCompressed();
+  return A;
+}
+
+// copyLimit 0: every factor solved through CHOLMOD, as large ones are.
+class PrefactoredCholeskyBothWays : public testing::TestWithParam<long> {};
+
+TEST_P(PrefactoredCholeskyBothWays, SolvesOneTwoAndThreeRightHandSides) {
+  const Model model(resampleCube(test::loadWorld("jello.w"), 6));
+  const int n = model.numPoints();
+  PrefactoredCholesky factor(GetParam());
+  EXPECT_FALSE(factor.factored());
+  for (double spread : {0.0, 0.2}) {  // the second: new values in the same pattern
+    const SparseMatrix A = laplacianSystem(model, 3.0, spread);
+    ASSERT_TRUE(factor.factorize(A).ok);
+    EXPECT_EQ(factor.size(), n);
+    EXPECT_GE(factor.nonZeros(), (A.nonZeros() + n) / 2);  // at least A's lower triangle
+    const Eigen::MatrixXd dense(A);
+    for (int columns = 1; columns <= 3; ++columns) {
+      SCOPED_TRACE(columns);
+      const Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, columns);
+      Eigen::MatrixXd X = B;
+      ASSERT_TRUE(factor.solve(X.data(), columns).ok);
+      EXPECT_LT((dense * X - B).norm(), 1e-12 * B.norm() * dense.norm());
+      const Eigen::MatrixXd expected = dense.llt().solve(B);
+      EXPECT_LT((X - expected).norm(), 1e-10 * expected.norm());
+    }
+  }
+}
+
+TEST_P(PrefactoredCholeskyBothWays, RefusesAMatrixThatIsNotPositiveDefinite) {
+  const Model model(resampleCube(test::loadWorld("jello.w"), 4));
+  PrefactoredCholesky factor(GetParam());
+  ASSERT_TRUE(factor.factorize(laplacianSystem(model, 1.0, 0.0)).ok);
+  // A Laplacian alone is singular; minus the identity it is indefinite.
+  const StepResult result = factor.factorize(laplacianSystem(model, -1.0, 0.0));
+  EXPECT_FALSE(result.ok);
+  EXPECT_NE(result.message.find("not positive definite"), std::string::npos) << result.message;
+  EXPECT_FALSE(factor.factored());
+  // and recovers: the same pattern factors again, as does another size.
+  EXPECT_TRUE(factor.factorize(laplacianSystem(model, 1.0, 0.0)).ok);
+  const Model bigger(resampleCube(test::loadWorld("jello.w"), 5));
+  ASSERT_TRUE(factor.factorize(laplacianSystem(bigger, 1.0, 0.0)).ok);
+  EXPECT_EQ(factor.size(), bigger.numPoints());
+}
+
+INSTANTIATE_TEST_SUITE_P(CopyAndCholmod, PrefactoredCholeskyBothWays,
+                         testing::Values(PrefactoredCholesky::kDefaultCopyLimit, 0L));
+
+}  // namespace
+}  // namespace jello
