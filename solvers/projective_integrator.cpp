@@ -1,10 +1,11 @@
 #include "solvers/projective_integrator.h"
 
-#include <Eigen/CholmodSupport>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
+#include "solvers/prefactored_cholesky.h"
+#include "solvers/spring_laplacian.h"
 #include "src/assertions.h"
 #include "src/interrupt.h"
 
@@ -21,15 +22,8 @@ double secondsSince(Clock::time_point start) {
 
 // The factors of A_0, A_1, A_2: all three coordinates share the first while no contact tells
 // them apart, and are then solved together (one pass over the factor for three columns).
-// Supernodal: measured at 8^3 over 1 s, CHOLMOD's simplicial LLT solves in 65 us instead of
-// 85 but factors in 1.9 ms instead of 0.7, which loses on jello.w (a factorization per contact
-// change); Eigen's own SimplicialLLT solves in 200 us.
 struct ProjectiveIntegrator::Factors {
-  std::array<Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower>, 3> llt;
-  std::array<bool, 3> analyzed{{false, false, false}};
-  Factors() {
-    for (auto& f : llt) f.cholmod().print = 0;  // failures are reported as StepResults
-  }
+  std::array<PrefactoredCholesky, 3> llt;
 };
 
 ProjectiveIntegrator::ProjectiveIntegrator(const ProjectiveOptions& options)
@@ -42,29 +36,9 @@ void ProjectiveIntegrator::bind(const Model& model) {
   modelId_ = model.id();
   n_ = model.numPoints();
   mass_ = model.mass();
-  // L: k on the diagonal of both ends of every spring, -k on (a,b) and (b,a).
-  std::vector<Eigen::Triplet<double, int>> entries;
-  const std::vector<Spring> springs = model.springs().springs();
-  entries.reserve(static_cast<std::size_t>(n_) + 4 * springs.size());
-  for (int p = 0; p < n_; ++p) entries.emplace_back(p, p, 0.0);
-  for (const Spring& s : springs) {
-    entries.emplace_back(s.a, s.a, s.stiffness);
-    entries.emplace_back(s.b, s.b, s.stiffness);
-    entries.emplace_back(s.a, s.b, -s.stiffness);
-    entries.emplace_back(s.b, s.a, -s.stiffness);
-  }
-  laplacian_.resize(n_, n_);
-  laplacian_.setFromTriplets(entries.begin(), entries.end());  // sums duplicates
-  laplacian_.makeCompressed();
-  diagonal_.assign(static_cast<std::size_t>(n_), -1);
-  for (int col = 0; col < n_; ++col) {
-    for (int i = laplacian_.outerIndexPtr()[col]; i < laplacian_.outerIndexPtr()[col + 1]; ++i) {
-      if (laplacian_.innerIndexPtr()[i] == col) diagonal_[static_cast<std::size_t>(col)] = i;
-    }
-  }
+  laplacian_ = std::make_unique<SpringLaplacian>(model);
   factors_ = std::make_unique<Factors>();  // a new pattern: analyzed afresh
   for (int c = 0; c < 3; ++c) {
-    A_[c] = laplacian_;
     weights_[c].setZero(n_);
     factoredWeights_[c].setZero(n_);
   }
@@ -118,24 +92,13 @@ StepResult ProjectiveIntegrator::factorChanged(double h) {
       continue;
     }
     if (!all && factorOf_[c] == c && weights_[c] == factoredWeights_[c]) continue;
-    const double* L = laplacian_.valuePtr();
-    double* A = A_[c].valuePtr();
-    std::copy(L, L + laplacian_.nonZeros(), A);
-    for (int p = 0; p < n_; ++p)
-      A[diagonal_[static_cast<std::size_t>(p)]] += inertia + weights_[c][p];
+    laplacian_->form(inertia, 0.0, 1.0, weights_[c].data(), A_[c]);
     const auto start = Clock::now();
-    auto& llt = factors_->llt[c];
-    if (!factors_->analyzed[c]) {
-      llt.analyzePattern(A_[c]);
-      if (llt.info() != Eigen::Success) return StepResult::failure("CHOLMOD analysis failed");
-      factors_->analyzed[c] = true;
-    }
-    llt.factorize(A_[c]);  // SPD by construction: M/h^2 > 0, L and W semidefinite
+    // SPD by construction: M/h^2 > 0, L and W semidefinite.
+    const StepResult factored = factors_->llt[c].factorize(A_[c]);
     factorSeconds_ += secondsSince(start);
     ++factorizations_;
-    if (llt.info() != Eigen::Success) {
-      return StepResult::failure("CHOLMOD could not factor the projective matrix");
-    }
+    if (!factored.ok) return StepResult::failure("projective matrix: " + factored.message);
     factoredWeights_[c] = weights_[c];
     factorOf_[c] = c;
   }
@@ -167,21 +130,16 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
     }
     // Global step: A_c delta_c = -r_c, the coordinates that share a factor solved together.
     const auto start = Clock::now();
-    const Eigen::Map<const Eigen::MatrixXd> r(r_.data(), n, 3);  // column c: coordinate c
+    delta_ = -Eigen::Map<const Eigen::MatrixXd>(r_.data(), n, 3);  // column c: coordinate c
+    StepResult solved = StepResult::success();
     if (factorOf_[1] == 0 && factorOf_[2] == 0) {
-      delta_ = factors_->llt[0].solve(-r);
-      if (factors_->llt[0].info() != Eigen::Success) {
-        return StepResult::failure("the CHOLMOD solve failed");
-      }
+      solved = factors_->llt[0].solve(delta_.data(), 3);
     } else {
-      delta_.resize(n, 3);
-      for (int c = 0; c < 3; ++c) {
-        auto& llt = factors_->llt[factorOf_[c]];
-        column_ = -r.col(c);  // reused: no allocation per iteration
-        delta_.col(c) = llt.solve(column_);
-        if (llt.info() != Eigen::Success) return StepResult::failure("the CHOLMOD solve failed");
+      for (int c = 0; c < 3 && solved.ok; ++c) {
+        solved = factors_->llt[factorOf_[c]].solve(delta_.col(c).data(), 1);
       }
     }
+    if (!solved.ok) return solved;
     solveSeconds_ += secondsSince(start);
     Eigen::Map<Eigen::MatrixXd>(x_.data(), n, 3) += delta_;
     const double update = delta_.cwiseAbs().maxCoeff();

@@ -35,6 +35,8 @@
 
 namespace jello {
 
+class SpringLaplacian;
+
 class ProjectiveIntegrator final : public Integrator {
  public:
   explicit ProjectiveIntegrator(const ProjectiveOptions& options = {});
@@ -61,16 +63,15 @@ class ProjectiveIntegrator final : public Integrator {
   long modelId_ = -1;
   int n_ = 0;
   double mass_ = 0.0;
-  double h_ = 0.0;                 // the step size the factors are for
-  SparseMatrix laplacian_;         // L (n x n), its pattern holds the diagonal
-  std::vector<int> diagonal_;      // value index of each diagonal entry of L
-  std::array<SparseMatrix, 3> A_;  // per coordinate: M/h^2 + L + W_c
+  double h_ = 0.0;  // the step size the factors are for
+  std::unique_ptr<SpringLaplacian> laplacian_;
+  std::array<SparseMatrix, 3> A_;                             // per coordinate: M/h^2 + L + W_c
   std::array<Eigen::VectorXd, 3> weights_, factoredWeights_;  // W_c: wanted, factored
   std::array<int, 3> factorOf_{{0, 1, 2}};  // which coordinate's factor each one uses
   struct Factors;                           // CHOLMOD's, one per distinct matrix
   std::unique_ptr<Factors> factors_;
   bool factored_ = false;
-  Eigen::VectorXd y_, x_, v_, f_, r_, column_;
+  Eigen::VectorXd y_, x_, v_, f_, r_;
   Eigen::MatrixXd delta_;  // n x 3, the update of each coordinate
   int lastIterations_ = 0;
   double lastUpdate_ = 0.0;
