@@ -2,6 +2,8 @@
 
 #include <chrono>
 
+#include "solvers/prefactored_cholesky.h"
+#include "solvers/spring_laplacian.h"
 #include "src/assertions.h"
 
 namespace jello {
@@ -11,13 +13,19 @@ ImplicitSystem::ImplicitSystem(const LinearSolverOptions& linearSolver, bool cla
       matrixFree_(linearSolver.kind == LinearSolverKind::Cg && linearSolver.matrixFree),
       solver_(linearSolver) {}
 
+ImplicitSystem::~ImplicitSystem() = default;
+
 bool ImplicitSystem::bind(const Model& model) {
+  model_ = &model;
   if (model.id() == modelId_) return false;
   modelId_ = model.id();
   jacobian_ = std::make_unique<JacobianAssembler>(model);
   if (matrixFree_) operator_ = std::make_unique<SystemOperator>(model.springs(), model.numPoints());
   A_ = jacobian_->pattern();
   solver_.forgetPattern();
+  laplacian_.reset();
+  projective_.reset();
+  projectiveA_ = projectiveB_ = -1.0;
   return true;
 }
 
@@ -31,11 +39,17 @@ void ImplicitSystem::assemble(const double* x) {
 
 void ImplicitSystem::formMatrix(double a, double b) {
   jacobian_->combine(a, b, A_);
+  a_ = a;
+  b_ = b;
 }
 
 StepResult ImplicitSystem::factorize() {
   if (operator_) operator_->gather(A_, jacobian_->diagonalSlots(), jacobian_->springSlots());
-  return solver_.factorize(A_, operator_.get());
+  if (solver_.kind() == LinearSolverKind::Cg &&
+      solver_.preconditioner() == PreconditionerKind::Projective) {
+    if (StepResult res = factorProjective(a_, b_); !res.ok) return res;
+  }
+  return solver_.factorize(A_, operator_.get(), projective_.get());
 }
 
 StepResult ImplicitSystem::factorize(double a, double b) {
@@ -43,8 +57,39 @@ StepResult ImplicitSystem::factorize(double a, double b) {
   return factorize();
 }
 
-StepResult ImplicitSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) {
-  return solver_.solve(rhs, x);
+StepResult ImplicitSystem::factorProjective(double a, double b) {
+  JELLO_ASSERT(model_ && model_->id() == modelId_, "the projective matrix is for the bound model");
+  const Model& model = *model_;
+  if (projective_ && projective_->factored() && a == projectiveA_ && b == projectiveB_) {
+    return StepResult::success();
+  }
+  if (!laplacian_) {
+    laplacian_ = std::make_unique<SpringLaplacian>(model);
+    projective_ = std::make_unique<PrefactoredCholesky>();
+  }
+  const auto start = std::chrono::steady_clock::now();
+  laplacian_->form(model.mass(), a, b, nullptr, projectiveMatrix_);
+  StepResult result = projective_->factorize(projectiveMatrix_);
+  projectiveSeconds_ +=
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ++projectiveFactorizations_;
+  if (!result.ok) {
+    projectiveA_ = projectiveB_ = -1.0;
+    return StepResult::failure("the projective matrix: " + result.message);
+  }
+  projectiveA_ = a;
+  projectiveB_ = b;
+  return StepResult::success();
+}
+
+StepResult ImplicitSystem::solveProjective(Eigen::VectorXd& v) const {
+  JELLO_ASSERT(projective_ && projective_->factored() && v.size() == 3 * projective_->size(),
+               "solveProjective follows a successful factorProjective");
+  return projective_->solve(v.data(), 3);
+}
+
+StepResult ImplicitSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double tolerance) {
+  return solver_.solve(rhs, x, tolerance);
 }
 
 void ImplicitSystem::appendStatistics(std::vector<Statistic>& out) const {
@@ -55,6 +100,10 @@ void ImplicitSystem::appendStatistics(std::vector<Statistic>& out) const {
   out.push_back({"assemble_time_s", assembleSeconds_});
   out.push_back({"factor_time_s", ls.factorSeconds});
   out.push_back({"solve_time_s", ls.solveSeconds});
+  if (projectiveFactorizations_ > 0) {
+    out.push_back({"projective_factorizations", static_cast<double>(projectiveFactorizations_)});
+    out.push_back({"projective_factor_time_s", projectiveSeconds_});
+  }
   if (solver_.kind() == LinearSolverKind::Cg) {
     out.push_back({"cg_iterations", static_cast<double>(ls.cgIterations)});
     if (solver_.preconditioner() == PreconditionerKind::IncompleteCholesky ||

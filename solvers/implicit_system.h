@@ -23,9 +23,13 @@
 
 namespace jello {
 
+class PrefactoredCholesky;
+class SpringLaplacian;
+
 class ImplicitSystem {
  public:
   ImplicitSystem(const LinearSolverOptions& linearSolver, bool clampCompression);
+  ~ImplicitSystem();
 
   // Binds to `model`; true when it is another model than the last (the pattern is rebuilt and
   // the solver analyses afresh: integrators must forget their history then).
@@ -41,8 +45,16 @@ class ImplicitSystem {
   StepResult factorize();
   // formMatrix(a, b), then factorize().
   StepResult factorize(double a, double b);
-  // x: on entry CG's initial guess, on return the solution of A x = rhs.
-  StepResult solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x);
+  // x: on entry CG's initial guess, on return the solution of A x = rhs (CG: to relative
+  // residual `tolerance` if that is looser than its own).
+  StepResult solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double tolerance = 0.0);
+
+  // The projective matrix P(a, b) = M + L(a c + b k) on each coordinate of the bound model
+  // (solvers/spring_laplacian.h), factored when a or b changed: CG's projective preconditioner
+  // and Newton's seed iterations. factorize() sets it up itself for CG.
+  StepResult factorProjective(double a, double b);
+  // v <- P^-1 v (3n, component-major) with the last factorProjective.
+  StepResult solveProjective(Eigen::VectorXd& v) const;
 
   const SparseMatrix& K() const { return jacobian_->K(); }
   const SparseMatrix& D() const { return jacobian_->D(); }
@@ -57,11 +69,19 @@ class ImplicitSystem {
  private:
   bool clampCompression_;
   long modelId_ = -1;
+  const Model* model_ = nullptr;  // the one of the last bind: alive while a step runs
   bool matrixFree_;
   std::unique_ptr<JacobianAssembler> jacobian_;
   std::unique_ptr<SystemOperator> operator_;  // cg, matrix-free
   SparseMatrix A_;
+  double a_ = 0.0, b_ = 0.0;  // of the last formMatrix
   SpdSolver solver_;
+  std::unique_ptr<SpringLaplacian> laplacian_;  // projective: built on first use per model
+  std::unique_ptr<PrefactoredCholesky> projective_;
+  SparseMatrix projectiveMatrix_;
+  double projectiveA_ = -1.0, projectiveB_ = -1.0;  // what projective_ holds
+  long projectiveFactorizations_ = 0;
+  double projectiveSeconds_ = 0.0;
   double assembleSeconds_ = 0.0;
 };
 

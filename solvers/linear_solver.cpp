@@ -7,6 +7,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "solvers/prefactored_cholesky.h"
 #include "solvers/system_operator.h"
 
 namespace jello {
@@ -29,9 +30,10 @@ struct SpdSolver::Impl {
   bool lltAnalyzed = false;
   // cg: the operator (or A itself), the preconditioner's data, the work vectors.
   const SystemOperator* op = nullptr;
-  Eigen::VectorXd invDiagonal;                  // jacobi
-  std::array<Eigen::VectorXd, 6> blockInverse;  // block-jacobi: per point, upper triangle
-  bool staleFactor = false;                     // factor: llt holds an earlier A's factor
+  const PrefactoredCholesky* projective = nullptr;  // projective
+  Eigen::VectorXd invDiagonal;                      // jacobi
+  std::array<Eigen::VectorXd, 6> blockInverse;      // block-jacobi: per point, upper triangle
+  bool staleFactor = false;                         // factor: llt holds an earlier A's factor
   bool icholAnalyzed = false;
   long lastIterations = 0;
   Eigen::VectorXd r, z, p, q;
@@ -91,6 +93,7 @@ std::optional<PreconditionerKind> parsePreconditioner(std::string_view name) {
   if (name == "block-jacobi") return PreconditionerKind::BlockJacobi;
   if (name == "ichol") return PreconditionerKind::IncompleteCholesky;
   if (name == "factor") return PreconditionerKind::Factor;
+  if (name == "projective") return PreconditionerKind::Projective;
   return std::nullopt;
 }
 
@@ -104,6 +107,8 @@ std::string_view preconditionerName(PreconditionerKind kind) {
       return "ichol";
     case PreconditionerKind::Factor:
       return "factor";
+    case PreconditionerKind::Projective:
+      return "projective";
   }
   return "?";
 }
@@ -206,11 +211,17 @@ StepResult SpdSolver::setUpPreconditioner(const SparseMatrix& A) {
             "the preconditioner's factorization failed (not positive definite)");
       }
       return StepResult::success();
+    case PreconditionerKind::Projective:
+      if (!s.projective || !s.projective->factored() || s.projective->size() * 3 != n3) {
+        return StepResult::failure("the projective preconditioner has no factored Laplacian");
+      }
+      return StepResult::success();
   }
   return StepResult::success();
 }
 
-StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::VectorXd& x,
+                                         double relativeTolerance) {
   Impl& s = *impl_;
   const Eigen::Index n3 = b.size(), n = n3 / 3;
   if (x.size() != n3) x.setZero(n3);
@@ -222,6 +233,7 @@ StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::Vector
       out.noalias() = *s.A * v;
     }
   };
+  StepResult preconditioned = StepResult::success();
   const auto precondition = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
     switch (preconditioner_) {
       case PreconditionerKind::Jacobi:
@@ -244,6 +256,10 @@ StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::Vector
       case PreconditionerKind::Factor:
         z = s.llt.solve(r);
         break;
+      case PreconditionerKind::Projective:
+        z = r;  // component-major: the x, y and z columns of one n x 3 system
+        if (preconditioned.ok) preconditioned = s.projective->solve(z.data(), 3);
+        break;
     }
   };
   const double bNorm = b.norm();
@@ -252,7 +268,7 @@ StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::Vector
     s.lastIterations = 0;
     return StepResult::success();
   }
-  const double tolerance = cgTolerance_ * bNorm;
+  const double tolerance = relativeTolerance * bNorm;
   const long maxIterations = std::max<long>(10, 2 * n3);
   product(x, s.q);
   s.r = b - s.q;
@@ -260,6 +276,7 @@ StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::Vector
   long it = 0;
   if (residual > tolerance) {
     precondition(s.r, s.z);
+    if (!preconditioned.ok) return preconditioned;
     s.p = s.z;
     double rz = s.r.dot(s.z);
     while (true) {
@@ -277,6 +294,7 @@ StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::Vector
       residual = s.r.norm();
       if (residual <= tolerance || it >= maxIterations) break;
       precondition(s.r, s.z);
+      if (!preconditioned.ok) return preconditioned;
       const double rzNext = s.r.dot(s.z);
       s.p = s.z + (rzNext / rz) * s.p;
       rz = rzNext;
@@ -293,7 +311,8 @@ StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::Vector
   return StepResult::success();
 }
 
-StepResult SpdSolver::factorize(const SparseMatrix& A, const SystemOperator* op) {
+StepResult SpdSolver::factorize(const SparseMatrix& A, const SystemOperator* op,
+                                const PrefactoredCholesky* projective) {
   const auto start = Clock::now();
   Impl& s = *impl_;
   s.A = &A;
@@ -323,6 +342,7 @@ StepResult SpdSolver::factorize(const SparseMatrix& A, const SystemOperator* op)
       break;
     case LinearSolverKind::Cg:
       s.op = op;
+      s.projective = projective;
       result = setUpPreconditioner(A);
       break;
   }
@@ -331,12 +351,12 @@ StepResult SpdSolver::factorize(const SparseMatrix& A, const SystemOperator* op)
   return result;
 }
 
-StepResult SpdSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+StepResult SpdSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x, double tolerance) {
   const auto start = Clock::now();
   Impl& s = *impl_;
   StepResult result = StepResult::success();
   if (kind_ == LinearSolverKind::Cg) {
-    result = conjugateGradients(b, x);
+    result = conjugateGradients(b, x, std::max(tolerance, cgTolerance_));
   } else if (s.useLdlt) {
     x = s.ldlt.solve(b);
     if (s.ldlt.info() != Eigen::Success) {

@@ -14,6 +14,9 @@
 //              factor        a CHOLMOD factorization of an earlier A, kept while CG converges
 //                            in few iterations (at most kStaleFactorIterations) and refreshed at
 //                            the next set-up after a solve that needed more
+//              projective    the springs' Laplacian M + L(a c + b k) on each coordinate
+//                            (solvers/spring_laplacian.h), factored once per a and b: it bounds
+//                            A's spring part from above, so it is kept however the cube turns
 #pragma once
 
 #include <Eigen/Core>
@@ -28,11 +31,11 @@
 namespace jello {
 
 enum class LinearSolverKind { Cholmod, Ldlt, Cg };
-enum class PreconditionerKind { Jacobi, BlockJacobi, IncompleteCholesky, Factor };
+enum class PreconditionerKind { Jacobi, BlockJacobi, IncompleteCholesky, Factor, Projective };
 
 std::optional<LinearSolverKind> parseLinearSolver(std::string_view name);
 std::string_view linearSolverName(LinearSolverKind kind);
-// "jacobi", "block-jacobi", "ichol", "factor".
+// "jacobi", "block-jacobi", "ichol", "factor", "projective".
 std::optional<PreconditionerKind> parsePreconditioner(std::string_view name);
 std::string_view preconditionerName(PreconditionerKind kind);
 
@@ -47,6 +50,7 @@ struct LinearSolverOptions {
 };
 
 class SystemOperator;
+class PrefactoredCholesky;
 
 struct LinearSolverStats {
   long analyses = 0;
@@ -68,12 +72,15 @@ class SpdSolver {
   SpdSolver& operator=(const SpdSolver&) = delete;
 
   // Prepares to solve with A; every A passed must have the same pattern until forgetPattern().
-  // cg: `op`, when given, holds the same A (gathered) and takes the products.
-  StepResult factorize(const SparseMatrix& A, const SystemOperator* op = nullptr);
+  // cg: `op`, when given, holds the same A (gathered) and takes the products; `projective`, the
+  // factored Laplacian the projective preconditioner solves with (required for it).
+  StepResult factorize(const SparseMatrix& A, const SystemOperator* op = nullptr,
+                       const PrefactoredCholesky* projective = nullptr);
   // The next factorize analyzes its matrix's pattern afresh (a new model).
   void forgetPattern();
-  // x: on entry the initial guess (cg), on return the solution.
-  StepResult solve(const Eigen::VectorXd& b, Eigen::VectorXd& x);
+  // x: on entry the initial guess (cg), on return the solution. cg stops at relative residual
+  // `tolerance` when it is given and larger than the configured one (an inexact Newton solve).
+  StepResult solve(const Eigen::VectorXd& b, Eigen::VectorXd& x, double tolerance = 0.0);
 
   LinearSolverKind kind() const { return kind_; }
   PreconditionerKind preconditioner() const { return preconditioner_; }
@@ -82,7 +89,8 @@ class SpdSolver {
  private:
   struct Impl;
   StepResult setUpPreconditioner(const SparseMatrix& A);
-  StepResult conjugateGradients(const Eigen::VectorXd& b, Eigen::VectorXd& x);
+  StepResult conjugateGradients(const Eigen::VectorXd& b, Eigen::VectorXd& x,
+                                double relativeTolerance);
   LinearSolverKind kind_;
   PreconditionerKind preconditioner_ = PreconditionerKind::Jacobi;
   double cgTolerance_;

@@ -41,6 +41,10 @@
 // update then taken whole: the absolute floor that ends the iterations at rest, where round-off
 // keeps the relative test from being met. A step
 // that reaches newtonMaxIterations is accepted, counted and reported, never silent.
+// Optionally (seedIterations) Newton starts where a few iterations with the constant projective
+// matrix P = M + L(a c + b k) left the inertial guess: for backward Euler these are projective
+// dynamics' iterations (solvers/projective_integrator.h), for every method a descent that needs
+// no assembly and no factorization; Newton then has less far to go. The step is the same.
 #pragma once
 
 #include <Eigen/Core>
@@ -98,6 +102,8 @@ class NewtonIntegrator : public Integrator {
   // Assembles K and D at the iterate and, when `refactor`, factors
   // A = M - (sigma h^2/gamma) D - (theta h^2/gamma) K there.
   StepResult prepareNewtonMatrix(double h, bool refactor);
+  // options_.seedIterations projective iterations on d_ (ImplicitOptions::seedIterations).
+  StepResult seed(const Model& model, double inertia, double h);
   std::pair<double, double> matrixCoefficients(double h) const;
 
   ImplicitOptions options_;
@@ -112,7 +118,7 @@ class NewtonIntegrator : public Integrator {
   double lastResidual_ = 0.0;
   bool lastConverged_ = true;
   long steps_ = 0, iterations_ = 0, maxIterations_ = 0, cuts_ = 0, searchFailures_ = 0,
-       unconverged_ = 0, reuses_ = 0;
+       unconverged_ = 0, reuses_ = 0, seeds_ = 0;
 };
 
 // The four methods state only their forms; construction is the base's (ImplicitOptions or

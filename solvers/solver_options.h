@@ -19,6 +19,11 @@ struct ImplicitOptions {
   // coefficients or the model changed). The converged step is the same; only the cost changes.
   bool reuseFactor = true;
   double refactorRatio = 0.5;
+  // Seed iterations: before Newton, up to this many iterations d <- d - P^-1 (h^2/gamma) r(d)
+  // with the projective matrix P = M + L(a c + b k) (solvers/spring_laplacian.h), factored once
+  // per step size; each costs a force evaluation and a back-substitution, no assembly. They stop
+  // at the first iterate in contact (P does not bound the penalty springs). 0: none.
+  int seedIterations = 0;
   // implicit-linear (one solve per step): a step during which a contact begins is not near its
   // linearization (the penalty spring was not in the matrix), so it gets up to this many
   // Newton iterations, to this relative residual: the penalty must act, that's all.

@@ -141,6 +141,29 @@ bool Model::contactBegins(const double* x0, const double* x1) const {
   return false;
 }
 
+bool Model::inContact(const double* x) const {
+  const int n = n_;
+  if (walls_) {
+    for (int i = 0; i < 3 * n; ++i) {
+      if (std::abs(x[i]) > kBoxHalfSize) return true;
+    }
+  }
+  if (!plane_ && !sphere_ && obstacles_.empty()) return false;
+  for (int p = 0; p < n; ++p) {
+    if (insideSolid({x[p], x[n + p], x[2 * n + p]})) return true;
+  }
+  return false;
+}
+
+bool Model::insideSolid(const Vec3& x) const {
+  if (plane_ && dot(plane_->normal(), x) + plane_->offset() < 0.0) return true;
+  if (sphere_ && norm(x - sphere_->sphere().center) < sphere_->sphere().radius) return true;
+  for (const ObstacleContact& o : obstacles_) {
+    if (o.inside(x)) return true;
+  }
+  return false;
+}
+
 double Model::userForceWork(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1) const {
   return userForce_ ? userForce_->dot(x1 - x0) : 0.0;
 }

@@ -81,6 +81,8 @@ class Model {
   // True when some point is in contact (with a wall, the plane or the sphere) at positions x1
   // but was not at x0: the contact set changed between them.
   bool contactBegins(const double* x0, const double* x1) const;
+  // True when some point is in contact (wall, plane, sphere or obstacle) at positions x.
+  bool inContact(const double* x) const;
 
   // Work (J) the force field does on the points moving from x0 to x1 (3n each), by the
   // trapezoid rule along the straight path: sum of 1/2 (F(x0) + F(x1)) . (x1 - x0). Exact for
@@ -126,6 +128,8 @@ class Model {
   bool hasUserForce() const { return userForce_.has_value(); }
 
  private:
+  // x on the solid side of the plane, inside the sphere or inside an obstacle.
+  bool insideSolid(const Vec3& x) const;
   long id_;
   int n_;
   double mass_;

@@ -226,9 +226,9 @@ TEST(ImplicitSystem, SolvesTheMassMinusScaledJacobiansAtTheAssembledState) {
   std::vector<LinearSolverOptions> solvers = {{LinearSolverKind::Cholmod, 1e-10},
                                               {LinearSolverKind::Ldlt, 1e-10}};
   // CG with every preconditioner, matrix-free and through the sparse matrix: the same solution.
-  for (PreconditionerKind pre :
-       {PreconditionerKind::Jacobi, PreconditionerKind::BlockJacobi,
-        PreconditionerKind::IncompleteCholesky, PreconditionerKind::Factor}) {
+  for (PreconditionerKind pre : {PreconditionerKind::Jacobi, PreconditionerKind::BlockJacobi,
+                                 PreconditionerKind::IncompleteCholesky, PreconditionerKind::Factor,
+                                 PreconditionerKind::Projective}) {
     for (bool matrixFree : {true, false}) {
       solvers.push_back({LinearSolverKind::Cg, 1e-11, pre, matrixFree});
     }

@@ -203,7 +203,8 @@ void Panel::solverOptions(const Frame& frame, SimRunner& runner) {
     solver = static_cast<LinearSolverKind>(k);
     if (solver == LinearSolverKind::Cg) {
       int p = static_cast<int>(preconditioner);
-      changed |= ImGui::Combo("preconditioner", &p, "jacobi\0block-jacobi\0ichol\0factor\0");
+      changed |=
+          ImGui::Combo("preconditioner", &p, "jacobi\0block-jacobi\0ichol\0factor\0projective\0");
       preconditioner = static_cast<PreconditionerKind>(p);
     }
   };
@@ -221,6 +222,8 @@ void Panel::solverOptions(const Frame& frame, SimRunner& runner) {
       ImGui::SliderInt("newton iters", &o.implicit.newtonMaxIterations, 1, 100);
       changed |= released();
       changed |= ImGui::Checkbox("keep factor", &o.implicit.reuseFactor);
+      ImGui::SliderInt("seed iterations", &o.implicit.seedIterations, 0, 100);
+      changed |= released();
       break;
     case IntegratorKind::Cvode: {
       int method = static_cast<int>(o.cvode.method);

@@ -9,10 +9,12 @@
 //   BM_StiffOneSecond/<method>/E  stiffCube(10^E) for 1 simulated second: implicit at
 //                               dt = 0.01 against RK4 at its largest stable dt (bisection)
 //   BM_ImplicitIntegratorStep/<integrator>/N/spinning  one step at dt = 0.01 (projective: 10
-//                               iterations; also at N = 32 on jello.w)
+//                               iterations; also at N = 32 on jello.w; implicit_cg: CG with
+//                               Jacobi; implicit_fast: fastNewton() below)
 //   BM_Crossover/<method>/E     1 simulated second of the spinning stretched cube at k = 10^E
 //                               with damping 0.25 (8^3): projective at dt = 1/60, implicit and
-//                               bdf2 at dt = 0.01, RK4 at 0.9 of its measured stability limit;
+//                               bdf2 at dt = 0.01 (also in fastNewton's configuration), RK4 at
+//                               0.9 of its measured stability limit;
 //                               the time is wall time per simulated second
 #include <benchmark/benchmark.h>
 
@@ -165,12 +167,23 @@ BENCHMARK_CAPTURE(BM_ImplicitStep, cg, LinearSolverKind::Cg)
 // One step of every implicit integrator at dt = 0.01, on jello.w and on the spinning,
 // stretched, undamped stiff cube (k = 1e4), resampled to N^3 (range 0: N; 1: 0 jello, 1 cube):
 // the converged ones take several factorizations a step (counter newton_per_step).
-void BM_ImplicitIntegratorStep(benchmark::State& st, IntegratorKind kind) {
+// The converged Newton methods' fastest configuration measured (README, Implicit solvers): CG
+// preconditioned by the projective matrix, after up to 30 projective seed iterations.
+SolverOptions fastNewton() {
+  SolverOptions o;
+  o.implicit.linearSolver = LinearSolverKind::Cg;
+  o.implicit.preconditioner = PreconditionerKind::Projective;
+  o.implicit.seedIterations = 30;
+  return o;
+}
+
+void BM_ImplicitIntegratorStep(benchmark::State& st, IntegratorKind kind,
+                               const SolverOptions& options = {}) {
   const int n = static_cast<int>(st.range(0));
   SceneSpec spinning = vibratingStiffCube(1e4);
   spinning.dElastic = 0.0;
   const World w = st.range(1) == 0 ? jelloAt(n) : resampleCube(buildWorld(spinning), n);
-  Simulation sim(w, kind, 0.01);
+  Simulation sim(w, kind, 0.01, options);
   for (auto _ : st) {
     if (!sim.step().ok) st.SkipWithError("step failed");
   }
@@ -179,12 +192,18 @@ void BM_ImplicitIntegratorStep(benchmark::State& st, IntegratorKind kind) {
     if (s.name == "newton_unconverged_steps") st.counters["unconverged"] = s.value;
   }
 }
-#define JELLO_IMPLICIT_STEP_BENCHMARK(name, kind)          \
-  BENCHMARK_CAPTURE(BM_ImplicitIntegratorStep, name, kind) \
-      ->ArgsProduct({{8, 16}, {0, 1}})                     \
-      ->ArgNames({"N", "spinning"})                        \
+#define JELLO_IMPLICIT_STEP_BENCHMARK(name, ...)                  \
+  BENCHMARK_CAPTURE(BM_ImplicitIntegratorStep, name, __VA_ARGS__) \
+      ->ArgsProduct({{8, 16}, {0, 1}})                            \
+      ->ArgNames({"N", "spinning"})                               \
       ->Unit(benchmark::kMillisecond)
 JELLO_IMPLICIT_STEP_BENCHMARK(implicit, IntegratorKind::Implicit);
+JELLO_IMPLICIT_STEP_BENCHMARK(implicit_cg, IntegratorKind::Implicit, [] {
+  SolverOptions o;
+  o.implicit.linearSolver = LinearSolverKind::Cg;
+  return o;
+}());
+JELLO_IMPLICIT_STEP_BENCHMARK(implicit_fast, IntegratorKind::Implicit, fastNewton());
 JELLO_IMPLICIT_STEP_BENCHMARK(implicit_linear, IntegratorKind::ImplicitLinear);
 JELLO_IMPLICIT_STEP_BENCHMARK(midpoint, IntegratorKind::Midpoint);
 JELLO_IMPLICIT_STEP_BENCHMARK(newmark, IntegratorKind::Newmark);
@@ -282,26 +301,28 @@ BENCHMARK_CAPTURE(BM_StiffOneSecond, implicit_cg_dt001, IntegratorKind::Implicit
     ->Iterations(3)
     ->Unit(benchmark::kMillisecond);
 
-void BM_Crossover(benchmark::State& st, IntegratorKind kind) {
+void BM_Crossover(benchmark::State& st, IntegratorKind kind, const SolverOptions& options = {}) {
   const World w = buildWorld(vibratingStiffCube(std::pow(10.0, static_cast<double>(st.range(0)))));
   double dt = 0.01;
   if (kind == IntegratorKind::Projective) dt = 1.0 / 60.0;
   if (kind == IntegratorKind::RK4) dt = largestStableRk4Step(w, 0.9);
   for (auto _ : st) {
-    Simulation sim(w, kind, dt);
+    Simulation sim(w, kind, dt, options);
     if (!runOneSecond(sim)) st.SkipWithError("diverged");
   }
   st.counters["dt_s"] = dt;
 }
-#define JELLO_CROSSOVER_BENCHMARK(name, kind) \
-  BENCHMARK_CAPTURE(BM_Crossover, name, kind) \
-      ->Arg(4)                                \
-      ->Arg(5)                                \
-      ->Iterations(3)                         \
+#define JELLO_CROSSOVER_BENCHMARK(name, ...)         \
+  BENCHMARK_CAPTURE(BM_Crossover, name, __VA_ARGS__) \
+      ->Arg(4)                                       \
+      ->Arg(5)                                       \
+      ->Iterations(3)                                \
       ->Unit(benchmark::kMillisecond)
 JELLO_CROSSOVER_BENCHMARK(rk4, IntegratorKind::RK4);
 JELLO_CROSSOVER_BENCHMARK(projective, IntegratorKind::Projective);
 JELLO_CROSSOVER_BENCHMARK(implicit, IntegratorKind::Implicit);
 JELLO_CROSSOVER_BENCHMARK(bdf2, IntegratorKind::Bdf2);
+JELLO_CROSSOVER_BENCHMARK(implicit_fast, IntegratorKind::Implicit, fastNewton());
+JELLO_CROSSOVER_BENCHMARK(bdf2_fast, IntegratorKind::Bdf2, fastNewton());
 
 }  // namespace

@@ -333,9 +333,10 @@ int main(int argc, char** argv) {
       ->group(implicitGroup);
   app.add_option("--preconditioner", opt.preconditioner,
                  "cg: jacobi, block-jacobi (each point's 3x3 block), ichol (incomplete "
-                 "Cholesky) or factor (a CHOLMOD factor of an earlier matrix, refreshed when CG "
-                 "needs more than 10 iterations)")
-      ->check(CLI::IsMember({"jacobi", "block-jacobi", "ichol", "factor"}))
+                 "Cholesky), factor (a CHOLMOD factor of an earlier matrix, refreshed when CG "
+                 "needs more than 10 iterations) or projective (the springs' Laplacian "
+                 "M + L(a c + b k), factored once per step size)")
+      ->check(CLI::IsMember({"jacobi", "block-jacobi", "ichol", "factor", "projective"}))
       ->capture_default_str()
       ->group(implicitGroup);
   app.add_flag("--csr-product", opt.csrProduct,
@@ -373,6 +374,12 @@ int main(int argc, char** argv) {
                  "implicit, midpoint, newmark, bdf2: factor afresh when an iteration shrinks "
                  "the residual by less than this")
       ->check(jello::cli::range(1e-6, 1.0))
+      ->capture_default_str()
+      ->group(implicitGroup);
+  app.add_option("--newton-seed", implicit.seedIterations,
+                 "implicit, midpoint, newmark, bdf2: iterations with the constant projective "
+                 "matrix before Newton (stopped at the first iterate in contact; 0: none)")
+      ->check(jello::cli::range(0, 1000))
       ->capture_default_str()
       ->group(implicitGroup);
   auto& projective = opt.solver.projective;

@@ -137,7 +137,7 @@ void translateExceptions(std::exception_ptr p) {
 // The keywords mirror jello-sim's flags with '_' for '-' (README "From Python").
 constexpr const char* kSolverOptionNames =
     "linear_solver, preconditioner, matrix_free, clamp, cg_tol, newton_iters, newton_tol, "
-    "newton_xtol, factor_reuse, "
+    "newton_xtol, factor_reuse, newton_seed, "
     "refactor_ratio, projective_iters, projective_tol, rtol, cvode_method, cvode_krylov, atol, "
     "atol_x, atol_v, contact_roots, max_order, stab_lim_det, max_step";
 
@@ -158,7 +158,10 @@ jello::SolverOptions solverOptionsFrom(const py::kwargs& kwargs, jello::SolverOp
       o.implicit.linearSolver = o.cvode.linearSolver = *kind;
     } else if (name == "preconditioner") {
       const auto kind = jello::parsePreconditioner(as<std::string>(value, name));
-      if (!kind) valueError("preconditioner must be 'jacobi', 'block-jacobi', 'ichol' or 'factor'");
+      if (!kind) {
+        valueError(
+            "preconditioner must be 'jacobi', 'block-jacobi', 'ichol', 'factor' or 'projective'");
+      }
       o.implicit.preconditioner = o.cvode.preconditioner = *kind;
     } else if (name == "matrix_free") {
       o.implicit.matrixFree = o.cvode.matrixFree = boolOption(value, name);
@@ -174,6 +177,8 @@ jello::SolverOptions solverOptionsFrom(const py::kwargs& kwargs, jello::SolverOp
       o.implicit.newtonPositionTolerance = positive(real(), n);
     } else if (name == "factor_reuse") {
       o.implicit.reuseFactor = boolOption(value, name);
+    } else if (name == "newton_seed") {
+      o.implicit.seedIterations = int(inRange(as<long>(value, name), 0, 1000, n));
     } else if (name == "refactor_ratio") {
       const double r = positive(real(), n);
       if (r < 1e-6 || r > 1.0) valueError("refactor_ratio must be between 1e-6 and 1");
