@@ -19,6 +19,9 @@ both:
     OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 0 build/release/bin/benchmarks \
       --benchmark_filter='Crossover|CvodeOneSecond/rtol1e3' \
       --benchmark_out=experiments/results/crossover.json --benchmark_out_format=json
+    OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 0 build/release/bin/benchmarks \
+      --benchmark_filter=KeptFactorSolve --benchmark_repetitions=3 \
+      --benchmark_out=experiments/results/kept_factor.json --benchmark_out_format=json
 """
 import argparse
 import csv
@@ -42,6 +45,22 @@ STEPS_BEGIN, STEPS_END = "<!-- implicit-steps:begin -->", "<!-- implicit-steps:e
 CROSSOVER_JSON = os.path.join(ROOT, "experiments", "results", "crossover.json")
 CROSSOVER_BEGIN, CROSSOVER_END = "<!-- crossover:begin -->", "<!-- crossover:end -->"
 CVODE_BEGIN, CVODE_END = "<!-- cvode-second:begin -->", "<!-- cvode-second:end -->"
+# BM_KeptFactorSolve (solvers/prefactored_cholesky.h), its own JSON.
+FACTOR_JSON = os.path.join(ROOT, "experiments", "results", "kept_factor.json")
+FACTOR_BEGIN, FACTOR_END = "<!-- kept-factor:begin -->", "<!-- kept-factor:end -->"
+
+# Benchmark variants of one integrator (experiments/bench/benchmarks_implicit.cpp), as the tables
+# name them.
+VARIANTS = {
+    "implicit-cg": "`implicit`, CG (jacobi)",
+    "implicit-fast": "`implicit`, CG (projective) after up to 30 seed iterations",
+    "bdf2-fast": "`bdf2`, CG (projective) after up to 30 seed iterations",
+}
+
+
+def label(name):
+    return VARIANTS.get(name, f"`{name}`")
+
 
 # integrator, dt (s), extra jello-sim arguments
 RUNS = [
@@ -133,7 +152,7 @@ def steps_table_from_json():
     lines = ["| integrator | jello.w 8^3 | spinning cube 8^3 | jello.w 16^3 | spinning cube 16^3 |",
              "|---|---|---|---|---|"]
     for name in order:
-        row = [f"`{name}`"]
+        row = [label(name)]
         for n, spinning in (("8", "0"), ("8", "1"), ("16", "0"), ("16", "1")):
             ms, newton = cells[(name, n, spinning)]
             text = f"{ms:.3g} ms" if ms < 1000 else f"{ms / 1e3:.3g} s"
@@ -171,7 +190,7 @@ def crossover_table_from_json():
              " | " + " | ".join(f"speed-up over RK4 at 1e{e}" for e in exponents) + " |",
              "|---|" + "---|" * (2 * len(exponents))]
     for method in order:
-        row = [f"`{method}`"]
+        row = [label(method)]
         for e in exponents:
             ms, dt = cells[(method, e)]
             row.append(f"{duration(ms)} ({dt:.3g} s)")
@@ -198,6 +217,38 @@ def cvode_table_from_json():
                      f"{b['cvode_steps']:.0f} | {b['error_test_failures']:.0f} | "
                      f"{b.get('factorizations', 0):.0f} |")
     return "\n".join(lines)
+
+
+def kept_factor_table_from_json():
+    """Three right-hand sides through projective's kept factor: the copy against CHOLMOD."""
+    with open(FACTOR_JSON) as f:
+        data = json.load(f)
+    cells, sizes = {}, []
+    for b in data["benchmarks"]:
+        if b.get("aggregate_name") != "median" or not b["name"].startswith("BM_KeptFactorSolve/"):
+            continue
+        _, how, n = b["name"].split("/")[:3]
+        n = n.split("_")[0]
+        if n not in sizes:
+            sizes.append(n)
+        cells[(how, n)] = (milliseconds(b), b["nnz_L"])
+    lines = ["| three right-hand sides, M/h^2 + L | " +
+             " | ".join(f"{n}^3 (L: {cells[('copy', n)][1]:,.0f} entries)" for n in sizes) + " |",
+             "|---|" + "---|" * len(sizes)]
+    for how, text in (("copy", "our substitutions over the copied factor"),
+                      ("cholmod", "CHOLMOD's `cholmod_solve2`")):
+        lines.append(f"| {text} | " + " | ".join(duration_fine(cells[(how, n)][0])
+                                                 for n in sizes) + " |")
+    lines.append("| ratio | " + " | ".join(
+        f"{cells[('copy', n)][0] / cells[('cholmod', n)][0]:.2f}" for n in sizes) + " |")
+    date = data["context"]["date"][:10]
+    lines.append("")
+    lines.append(f"Medians of 3 runs, {date}, one core (`experiments/results/kept_factor.json`).")
+    return "\n".join(lines)
+
+
+def duration_fine(ms):
+    return f"{ms * 1e3:.3g} us" if ms < 1 else duration(ms)
 
 
 def replace_between(text, begin, end, body):
@@ -249,6 +300,7 @@ def main():
         text = replace_between(text, STEPS_BEGIN, STEPS_END, steps_table_from_json())
         text = replace_between(text, CROSSOVER_BEGIN, CROSSOVER_END, crossover_table_from_json())
         text = replace_between(text, CVODE_BEGIN, CVODE_END, cvode_table_from_json())
+        text = replace_between(text, FACTOR_BEGIN, FACTOR_END, kept_factor_table_from_json())
         write_atomically(README, text)
 
 

@@ -11,6 +11,9 @@
 //   BM_ImplicitIntegratorStep/<integrator>/N/spinning  one step at dt = 0.01 (projective: 10
 //                               iterations; also at N = 32 on jello.w; implicit_cg: CG with
 //                               Jacobi; implicit_fast: fastNewton() below)
+//   BM_KeptFactorSolve/<copy|cholmod>/N  three right-hand sides solved with projective's kept
+//                               factor M/h^2 + L at N^3 (h = 0.01): our own substitutions over
+//                               the copied factor, or CHOLMOD's cholmod_solve2 (counter nnz_L)
 //   BM_Crossover/<method>/E     1 simulated second of the spinning stretched cube at k = 10^E
 //                               with damping 0.25 (8^3): projective at dt = 1/60, implicit and
 //                               bdf2 at dt = 0.01 (also in fastNewton's configuration), RK4 at
@@ -24,7 +27,9 @@
 #include "solvers/jacobian.h"
 #include "solvers/linear_solver.h"
 #include "solvers/newton_integrators.h"
+#include "solvers/prefactored_cholesky.h"
 #include "solvers/simulation.h"
+#include "solvers/spring_laplacian.h"
 #include "solvers/system_operator.h"
 #include "src/scene_builder.h"
 #include "src/world_reader.h"
@@ -213,6 +218,31 @@ BENCHMARK_CAPTURE(BM_ImplicitIntegratorStep, projective, IntegratorKind::Project
     ->Args({32, 0})
     ->ArgNames({"N", "spinning"})
     ->Unit(benchmark::kMillisecond);
+
+void BM_KeptFactorSolve(benchmark::State& st, bool copy) {
+  const Model model(jelloAt(static_cast<int>(st.range(0))));
+  const SpringLaplacian laplacian(model);
+  SparseMatrix A;
+  laplacian.form(model.mass() / 1e-4, 0.0, 1.0, nullptr, A);
+  PrefactoredCholesky factor(copy ? PrefactoredCholesky::kDefaultCopyLimit * 1000 : 0);
+  if (!factor.factorize(A).ok) st.SkipWithError("factorization failed");
+  Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(3 * model.numPoints(), -1.0, 1.0);
+  for (auto _ : st) {
+    if (!factor.solve(b.data(), 3).ok) st.SkipWithError("solve failed");
+    benchmark::DoNotOptimize(b.data());
+  }
+  st.counters["nnz_L"] = static_cast<double>(factor.nonZeros());
+}
+BENCHMARK_CAPTURE(BM_KeptFactorSolve, copy, true)
+    ->Arg(8)
+    ->Arg(12)
+    ->Arg(16)
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_KeptFactorSolve, cholmod, false)
+    ->Arg(8)
+    ->Arg(12)
+    ->Arg(16)
+    ->Unit(benchmark::kMicrosecond);
 
 // Runs `sim` to t = 1 s; false if it diverged.
 bool runOneSecond(Simulation& sim) {

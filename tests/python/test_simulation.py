@@ -132,6 +132,26 @@ def test_momentum_and_angular_momentum_are_conserved():
         assert np.linalg.norm(np.array(sim.angular_momentum()) - l0) < tolerance * np.linalg.norm(l0)
 
 
+def test_seeded_newton_takes_the_default_steps():
+    """newton_seed and the projective preconditioner change Newton's start and its linear
+    solves, not the converged backward-Euler steps (the solver options reach the C++ side)."""
+    world = jello.create_world(plane=None, pose="stretched", spin=1.5)
+    tight = dict(newton_tol=1e-12, newton_xtol=1e-12, newton_iters=100)
+    plain = jello.Simulation(world, integrator="implicit", dt=0.005, **tight)
+    seeded = jello.Simulation(world, integrator="implicit", dt=0.005, linear_solver="cg",
+                              preconditioner="projective", newton_seed=30, cg_tol=1e-12,
+                              **tight)
+    plain.run(steps=4)
+    seeded.run(steps=4)
+    assert np.abs(plain.positions - seeded.positions).max() < 1e-8
+    assert seeded.stats["solver"]["seed_iterations"] > 0
+    assert seeded.stats["solver"]["newton_iterations"] < plain.stats["solver"]["newton_iterations"]
+    with pytest.raises(ValueError, match="projective"):
+        jello.Simulation(world, integrator="implicit", preconditioner="nope")
+    with pytest.raises(ValueError):
+        jello.Simulation(world, integrator="implicit", newton_seed=-1)
+
+
 def test_run_callback_every_and_stop(jello_w):
     sim = jello.Simulation(jello_w)
     seen = []
