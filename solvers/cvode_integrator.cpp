@@ -10,6 +10,7 @@
 #include <iterator>
 #include <string>
 
+#include "solvers/fast_nvector.h"
 #include "src/interrupt.h"
 
 namespace jello {
@@ -141,6 +142,10 @@ StepResult CvodeIntegrator::start(const Model& model, const State& s) {
     y_.reset(N_VNew_Serial(2 * n3_, ctx));
     atol_.reset(N_VNew_Serial(2 * n3_, ctx));
     if (!y_ || !atol_) return StepResult::failure("N_VNew_Serial failed");
+    // CVODE clones its work vectors from y_: they inherit the faster loops.
+    if (!installFastOperations(y_.get()) || !installFastOperations(atol_.get())) {
+      return StepResult::failure("the serial vectors' operations could not be replaced");
+    }
     // A new model: the system rebuilds its pattern and its solver analyses afresh.
     system_.bind(model);
     b_.setZero(n3_);
