@@ -143,7 +143,8 @@ StepResult CvodeIntegrator::start(const Model& model, const State& s) {
     atol_.reset(N_VNew_Serial(2 * n3_, ctx));
     if (!y_ || !atol_) return StepResult::failure("N_VNew_Serial failed");
     // CVODE clones its work vectors from y_: they inherit the faster loops.
-    if (!installFastOperations(y_.get()) || !installFastOperations(atol_.get())) {
+    if (options_.fastVectors &&
+        (!installFastOperations(y_.get()) || !installFastOperations(atol_.get()))) {
       return StepResult::failure("the serial vectors' operations could not be replaced");
     }
     // A new model: the system rebuilds its pattern and its solver analyses afresh.

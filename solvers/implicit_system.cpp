@@ -1,12 +1,47 @@
 #include "solvers/implicit_system.h"
 
 #include <chrono>
+#include <cmath>
 
 #include "solvers/prefactored_cholesky.h"
 #include "solvers/spring_laplacian.h"
 #include "src/assertions.h"
 
 namespace jello {
+namespace {
+
+// C of factorProjective at positions x (3n): b kc + a dc per contact a point is in.
+void contactDiagonal(const Model& model, const double* x, double a, double b,
+                     Eigen::VectorXd& out) {
+  const int n = model.numPoints();
+  out.setZero(n);
+  const auto weight = [a, b](const ContactConstants& k) { return b * k.stiffness + a * k.damping; };
+  if (const auto& walls = model.walls()) {
+    const double w = weight(walls->constants());
+    for (int c = 0; c < 3; ++c)
+      for (int p = 0; p < n; ++p) {
+        if (std::abs(x[c * n + p]) > kBoxHalfSize) out[p] += w;
+      }
+  }
+  const auto& plane = model.plane();
+  const auto& sphere = model.sphere();
+  const auto& obstacles = model.obstacles();
+  if (!plane && !sphere && obstacles.empty()) return;
+  for (int p = 0; p < n; ++p) {
+    const Vec3 xp{x[p], x[n + p], x[2 * n + p]};
+    if (plane && dot(plane->normal(), xp) + plane->offset() < 0.0) {
+      out[p] += weight(plane->constants());
+    }
+    if (sphere && norm(xp - sphere->sphere().center) < sphere->sphere().radius) {
+      out[p] += weight(sphere->constants());
+    }
+    for (const ObstacleContact& o : obstacles) {
+      if (o.inside(xp)) out[p] += weight(o.constants());
+    }
+  }
+}
+
+}  // namespace
 
 ImplicitSystem::ImplicitSystem(const LinearSolverOptions& linearSolver, bool clampCompression)
     : clampCompression_(clampCompression),
@@ -33,6 +68,10 @@ void ImplicitSystem::assemble(const double* x) {
   JELLO_ASSERT(bound(), "the implicit system is bound to a model before it assembles");
   const auto start = std::chrono::steady_clock::now();
   jacobian_->assemble(x, {clampCompression_, false});
+  if (solver_.kind() == LinearSolverKind::Cg &&
+      solver_.preconditioner() == PreconditionerKind::Projective) {
+    x_ = Eigen::Map<const Eigen::VectorXd>(x, 3 * static_cast<Eigen::Index>(model_->numPoints()));
+  }
   assembleSeconds_ +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -47,7 +86,8 @@ StepResult ImplicitSystem::factorize() {
   if (operator_) operator_->gather(A_, jacobian_->diagonalSlots(), jacobian_->springSlots());
   if (solver_.kind() == LinearSolverKind::Cg &&
       solver_.preconditioner() == PreconditionerKind::Projective) {
-    if (StepResult res = factorProjective(a_, b_); !res.ok) return res;
+    contactDiagonal(*model_, x_.data(), a_, b_, contact_);
+    if (StepResult res = factorProjective(a_, b_, &contact_); !res.ok) return res;
   }
   return solver_.factorize(A_, operator_.get(), projective_.get());
 }
@@ -57,10 +97,15 @@ StepResult ImplicitSystem::factorize(double a, double b) {
   return factorize();
 }
 
-StepResult ImplicitSystem::factorProjective(double a, double b) {
+StepResult ImplicitSystem::factorProjective(double a, double b, const Eigen::VectorXd* contact) {
   JELLO_ASSERT(model_ && model_->id() == modelId_, "the projective matrix is for the bound model");
   const Model& model = *model_;
-  if (projective_ && projective_->factored() && a == projectiveA_ && b == projectiveB_) {
+  const bool noContact = !contact || contact->isZero(0.0);
+  const bool sameContact =
+      noContact ? projectiveContact_.size() == 0
+                : projectiveContact_.size() == contact->size() && projectiveContact_ == *contact;
+  if (projective_ && projective_->factored() && a == projectiveA_ && b == projectiveB_ &&
+      sameContact) {
     return StepResult::success();
   }
   if (!laplacian_) {
@@ -68,7 +113,7 @@ StepResult ImplicitSystem::factorProjective(double a, double b) {
     projective_ = std::make_unique<PrefactoredCholesky>();
   }
   const auto start = std::chrono::steady_clock::now();
-  laplacian_->form(model.mass(), a, b, nullptr, projectiveMatrix_);
+  laplacian_->form(model.mass(), a, b, noContact ? nullptr : contact->data(), projectiveMatrix_);
   StepResult result = projective_->factorize(projectiveMatrix_);
   projectiveSeconds_ +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -79,6 +124,11 @@ StepResult ImplicitSystem::factorProjective(double a, double b) {
   }
   projectiveA_ = a;
   projectiveB_ = b;
+  if (noContact) {
+    projectiveContact_.resize(0);
+  } else {
+    projectiveContact_ = *contact;
+  }
   return StepResult::success();
 }
 
@@ -88,8 +138,8 @@ StepResult ImplicitSystem::solveProjective(Eigen::VectorXd& v) const {
   return projective_->solve(v.data(), 3);
 }
 
-StepResult ImplicitSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double tolerance) {
-  return solver_.solve(rhs, x, tolerance);
+StepResult ImplicitSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) {
+  return solver_.solve(rhs, x);
 }
 
 void ImplicitSystem::appendStatistics(std::vector<Statistic>& out) const {

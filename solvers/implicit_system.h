@@ -45,14 +45,16 @@ class ImplicitSystem {
   StepResult factorize();
   // formMatrix(a, b), then factorize().
   StepResult factorize(double a, double b);
-  // x: on entry CG's initial guess, on return the solution of A x = rhs (CG: to relative
-  // residual `tolerance` if that is looser than its own).
-  StepResult solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double tolerance = 0.0);
+  // x: on entry CG's initial guess, on return the solution of A x = rhs.
+  StepResult solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x);
 
-  // The projective matrix P(a, b) = M + L(a c + b k) on each coordinate of the bound model
-  // (solvers/spring_laplacian.h), factored when a or b changed: CG's projective preconditioner
-  // and Newton's seed iterations. factorize() sets it up itself for CG.
-  StepResult factorProjective(double a, double b);
+  // The projective matrix P(a, b) = M + L(a c + b k) + C on each coordinate of the bound model
+  // (solvers/spring_laplacian.h), factored when a, b or C changed: CG's projective
+  // preconditioner and Newton's seed iterations. C, diagonal, bounds the contact springs' part of
+  // A: per point in contact, b kc + a dc for each wall, the plane, the sphere and each obstacle
+  // it is inside of (kc n n^T <= kc I), given as `contact` (n values, null: none). factorize()
+  // sets P up itself for CG, with the contacts of the last assembly's positions.
+  StepResult factorProjective(double a, double b, const Eigen::VectorXd* contact = nullptr);
   // v <- P^-1 v (3n, component-major) with the last factorProjective.
   StepResult solveProjective(Eigen::VectorXd& v) const;
 
@@ -80,6 +82,8 @@ class ImplicitSystem {
   std::unique_ptr<PrefactoredCholesky> projective_;
   SparseMatrix projectiveMatrix_;
   double projectiveA_ = -1.0, projectiveB_ = -1.0;  // what projective_ holds
+  Eigen::VectorXd projectiveContact_;               // C of projective_ (empty: none)
+  Eigen::VectorXd x_, contact_;                     // the last assembly's positions; C there
   long projectiveFactorizations_ = 0;
   double projectiveSeconds_ = 0.0;
   double assembleSeconds_ = 0.0;

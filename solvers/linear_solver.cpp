@@ -39,6 +39,7 @@ struct SpdSolver::Impl {
   Eigen::VectorXd r, z, p, q;
   bool ldltAnalyzed = false;
   bool useLdlt = false;             // this factorization went to LDLT
+  bool indefinite = false;          // cg met a direction of non-positive curvature
   const SparseMatrix* A = nullptr;  // for the residual check
 
   Impl() {
@@ -220,8 +221,7 @@ StepResult SpdSolver::setUpPreconditioner(const SparseMatrix& A) {
   return StepResult::success();
 }
 
-StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::VectorXd& x,
-                                         double relativeTolerance) {
+StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
   Impl& s = *impl_;
   const Eigen::Index n3 = b.size(), n = n3 / 3;
   if (x.size() != n3) x.setZero(n3);
@@ -268,7 +268,7 @@ StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::Vector
     s.lastIterations = 0;
     return StepResult::success();
   }
-  const double tolerance = relativeTolerance * bNorm;
+  const double tolerance = cgTolerance_ * bNorm;
   const long maxIterations = std::max<long>(10, 2 * n3);
   product(x, s.q);
   s.r = b - s.q;
@@ -284,6 +284,7 @@ StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::Vector
       const double pq = s.p.dot(s.q);
       if (!(pq > 0.0)) {
         s.lastIterations = it;
+        s.indefinite = true;
         return StepResult::failure(
             "CG: the matrix is not positive definite (p.Ap = " + std::to_string(pq) + ")");
       }
@@ -351,12 +352,23 @@ StepResult SpdSolver::factorize(const SparseMatrix& A, const SystemOperator* op,
   return result;
 }
 
-StepResult SpdSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x, double tolerance) {
+StepResult SpdSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
   const auto start = Clock::now();
   Impl& s = *impl_;
   StepResult result = StepResult::success();
-  if (kind_ == LinearSolverKind::Cg) {
-    result = conjugateGradients(b, x, std::max(tolerance, cgTolerance_));
+  if (kind_ == LinearSolverKind::Cg && !s.useLdlt) {
+    s.indefinite = false;
+    result = conjugateGradients(b, x);
+    // Not positive definite (possible only with the clamp off): LDLT until the next factorize,
+    // as cholmod falls back.
+    if (!result.ok && s.indefinite) {
+      ++stats_.fallbacks;
+      result = s.factorLdlt(*s.A, stats_);
+      s.useLdlt = result.ok;
+    }
+  }
+  if (!result.ok || (kind_ == LinearSolverKind::Cg && !s.useLdlt)) {
+    // solved by CG, or failed
   } else if (s.useLdlt) {
     x = s.ldlt.solve(b);
     if (s.ldlt.info() != Eigen::Success) {

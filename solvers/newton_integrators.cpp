@@ -143,10 +143,7 @@ StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
     const bool refactor = !options_.reuseFactor || norm > options_.refactorRatio * previousNorm;
     previousNorm = norm;
     if (StepResult res = prepareNewtonMatrix(h, refactor); !res.ok) return res;
-    // Inexact Newton: CG need not solve far below the residual Newton has left (forcing term
-    // sqrt of the relative residual, at most 0.1; the converged step is unchanged).
-    const double forcing = std::min(0.1, std::sqrt(lastResidual_));
-    if (StepResult res = system_.solve(rhs_, delta_, forcing); !res.ok) return res;
+    if (StepResult res = system_.solve(rhs_, delta_); !res.ok) return res;
     if (!delta_.allFinite()) return StepResult::failure("Newton produced a non-finite update");
     // An update this small is the answer to within it: the floor that ends the iterations at
     // rest, where round-off keeps the relative residual from falling.

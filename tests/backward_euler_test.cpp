@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "solvers/explicit_integrators.h"
+#include "solvers/linear_solver.h"
 #include "solvers/linearized_backward_euler.h"
 #include "solvers/newton_integrators.h"
 #include "src/scene_builder.h"
@@ -106,6 +108,7 @@ void expectTheThreeLinearSolversTakeTheSameStep() {
   State ref = initialState(cube.world);
   ImplicitOptions base;
   base.newtonTolerance = 1e-12;
+  base.linearSolver = LinearSolverKind::Cholmod;
   Method cholmod(base);
   ASSERT_TRUE(cholmod.step(cube.model, ref, 0.01).ok);
   for (LinearSolverKind kind : {LinearSolverKind::Ldlt, LinearSolverKind::Cg}) {
@@ -137,16 +140,36 @@ TEST(LinearizedBackwardEuler, FallsBackToLdltWhenTheUnclampedSystemIsIndefinite)
   const Model model(w);
   ImplicitOptions options;
   options.clampCompression = false;
+  options.linearSolver = LinearSolverKind::Cholmod;
   LinearizedBackwardEuler be(options);
   State s = initialState(w);
   const StepResult r = be.step(model, s, 0.01);
-  EXPECT_EQ(be.linearSolver().stats().fallbacks, 1);
+  EXPECT_EQ(be.linearSolver().stats().fallbacks, 1) << r.message;
   // Either a checked LDLT solution or a clear failure; never a silent NaN.
   if (r.ok) {
     EXPECT_TRUE(s.x.allFinite() && s.v.allFinite());
   } else {
     EXPECT_FALSE(r.message.empty());
   }
+}
+
+// CG that meets a direction of negative curvature falls back to LDLT too, and keeps it until
+// the next matrix: [[1 2 0] [2 1 0] [0 0 1]] has eigenvalues 3, -1, 1 and a positive diagonal.
+TEST(SpdSolver, CgFallsBackToLdltOnAnIndefiniteMatrix) {
+  SparseMatrix A(3, 3);
+  const std::vector<Eigen::Triplet<double, int>> entries = {
+      {0, 0, 1.0}, {1, 1, 1.0}, {2, 2, 1.0}, {0, 1, 2.0}, {1, 0, 2.0}};
+  A.setFromTriplets(entries.begin(), entries.end());
+  A.makeCompressed();
+  SpdSolver solver(LinearSolverKind::Cg, 1e-12);
+  ASSERT_TRUE(solver.factorize(A).ok);
+  const Eigen::Vector3d b(1.0, -1.0, 0.5);
+  for (int i = 0; i < 2; ++i) {
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(3);
+    ASSERT_TRUE(solver.solve(b, x).ok);
+    EXPECT_LT((A * x - b).norm(), 1e-12);
+  }
+  EXPECT_EQ(solver.stats().fallbacks, 1);  // the second solve used the kept LDLT
 }
 
 }  // namespace

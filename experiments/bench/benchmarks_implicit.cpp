@@ -9,8 +9,9 @@
 //   BM_StiffOneSecond/<method>/E  stiffCube(10^E) for 1 simulated second: implicit at
 //                               dt = 0.01 against RK4 at its largest stable dt (bisection)
 //   BM_ImplicitIntegratorStep/<integrator>/N/spinning  one step at dt = 0.01 (projective: 10
-//                               iterations; also at N = 32 on jello.w; implicit_cg: CG with
-//                               Jacobi; implicit_fast: fastNewton() below)
+//                               iterations; also at N = 32 on jello.w; the defaults solve by CG
+//                               with Jacobi; implicit_cholmod: by CHOLMOD; implicit_fast:
+//                               fastNewton() below)
 //   BM_KeptFactorSolve/<copy|cholmod>/N  three right-hand sides solved with projective's kept
 //                               factor M/h^2 + L at N^3 (h = 0.01): our own substitutions over
 //                               the copied factor, or CHOLMOD's cholmod_solve2 (counter nnz_L)
@@ -203,9 +204,9 @@ void BM_ImplicitIntegratorStep(benchmark::State& st, IntegratorKind kind,
       ->ArgNames({"N", "spinning"})                               \
       ->Unit(benchmark::kMillisecond)
 JELLO_IMPLICIT_STEP_BENCHMARK(implicit, IntegratorKind::Implicit);
-JELLO_IMPLICIT_STEP_BENCHMARK(implicit_cg, IntegratorKind::Implicit, [] {
+JELLO_IMPLICIT_STEP_BENCHMARK(implicit_cholmod, IntegratorKind::Implicit, [] {
   SolverOptions o;
-  o.implicit.linearSolver = LinearSolverKind::Cg;
+  o.implicit.linearSolver = LinearSolverKind::Cholmod;
   return o;
 }());
 JELLO_IMPLICIT_STEP_BENCHMARK(implicit_fast, IntegratorKind::Implicit, fastNewton());
@@ -254,32 +255,35 @@ bool runOneSecond(Simulation& sim) {
 }
 
 void BM_CvodeOneSecond(benchmark::State& st, double rtol, LinearSolverKind kind,
-                       CvodeMethod method = CvodeMethod::Bdf, bool krylov = false) {
+                       CvodeMethod method = CvodeMethod::Bdf, bool krylov = false,
+                       bool fastVectors = true) {
   SolverOptions options;
   options.cvode.rtol = rtol;
   options.cvode.linearSolver = kind;
   options.cvode.method = method;
   options.cvode.krylov = krylov;
+  options.cvode.fastVectors = fastVectors;
   for (auto _ : st) {
     Simulation sim(jelloAt(8), IntegratorKind::Cvode, 0.01, options);
     if (!runOneSecond(sim)) st.SkipWithError("cvode failed");
     for (const Statistic& s : sim.integrator().statistics()) st.counters[s.name] = s.value;
   }
 }
-BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e3_cholmod, 1e-3, LinearSolverKind::Cholmod)
-    ->Iterations(1)
-    ->Unit(benchmark::kSecond);
-BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e3_cg, 1e-3, LinearSolverKind::Cg)
-    ->Iterations(1)
-    ->Unit(benchmark::kSecond);
-BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e3_adams, 1e-3, LinearSolverKind::Cholmod,
-                  CvodeMethod::Adams)
-    ->Iterations(1)
-    ->Unit(benchmark::kSecond);
-BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e3_spgmr, 1e-3, LinearSolverKind::Cholmod,
-                  CvodeMethod::Bdf, true)
-    ->Iterations(1)
-    ->Unit(benchmark::kSecond);
+// One run each, three repetitions: the table reports the medians.
+#define JELLO_CVODE_SECOND(name, ...)                     \
+  BENCHMARK_CAPTURE(BM_CvodeOneSecond, name, __VA_ARGS__) \
+      ->Iterations(1)                                     \
+      ->Repetitions(3)                                    \
+      ->ReportAggregatesOnly(true)                        \
+      ->Unit(benchmark::kSecond)
+JELLO_CVODE_SECOND(rtol1e3_cholmod, 1e-3, LinearSolverKind::Cholmod);
+JELLO_CVODE_SECOND(rtol1e3_cg, 1e-3, LinearSolverKind::Cg);
+JELLO_CVODE_SECOND(rtol1e3_cg_sundials_vectors, 1e-3, LinearSolverKind::Cg, CvodeMethod::Bdf, false,
+                   false);
+JELLO_CVODE_SECOND(rtol1e3_adams, 1e-3, LinearSolverKind::Cg, CvodeMethod::Adams);
+JELLO_CVODE_SECOND(rtol1e3_adams_sundials_vectors, 1e-3, LinearSolverKind::Cg, CvodeMethod::Adams,
+                   false, false);
+JELLO_CVODE_SECOND(rtol1e3_spgmr, 1e-3, LinearSolverKind::Cholmod, CvodeMethod::Bdf, true);
 BENCHMARK_CAPTURE(BM_CvodeOneSecond, rtol1e6_cholmod, 1e-6, LinearSolverKind::Cholmod)
     ->Iterations(1)
     ->Unit(benchmark::kSecond);
@@ -352,6 +356,11 @@ JELLO_CROSSOVER_BENCHMARK(rk4, IntegratorKind::RK4);
 JELLO_CROSSOVER_BENCHMARK(projective, IntegratorKind::Projective);
 JELLO_CROSSOVER_BENCHMARK(implicit, IntegratorKind::Implicit);
 JELLO_CROSSOVER_BENCHMARK(bdf2, IntegratorKind::Bdf2);
+JELLO_CROSSOVER_BENCHMARK(implicit_cholmod, IntegratorKind::Implicit, [] {
+  SolverOptions o;
+  o.implicit.linearSolver = LinearSolverKind::Cholmod;
+  return o;
+}());
 JELLO_CROSSOVER_BENCHMARK(implicit_fast, IntegratorKind::Implicit, fastNewton());
 JELLO_CROSSOVER_BENCHMARK(bdf2_fast, IntegratorKind::Bdf2, fastNewton());
 

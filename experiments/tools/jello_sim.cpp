@@ -56,7 +56,7 @@ struct Options {
   long every = 100;
   bool quiet = false;
   jello::SolverOptions solver;
-  std::string linearSolver = "cholmod";
+  std::string linearSolver;  // empty: SolverOptions' defaults
   std::string preconditioner = "jacobi";
   bool csrProduct = false;
   bool noClamp = false, noStabLimDet = false, noFactorReuse = false;
@@ -327,9 +327,9 @@ int main(int argc, char** argv) {
   const char* implicitGroup =
       "Implicit solvers (implicit, midpoint, newmark, bdf2, implicit-linear, cvode)";
   app.add_option("--linear-solver", opt.linearSolver,
-                 "cholmod (supernodal LLT), ldlt, or cg (Jacobi-preconditioned, warm-started)")
+                 "cg (preconditioned, warm-started, matrix-free; the default), cholmod "
+                 "(supernodal LLT) or ldlt")
       ->check(CLI::IsMember({"cholmod", "ldlt", "cg"}))
-      ->capture_default_str()
       ->group(implicitGroup);
   app.add_option("--preconditioner", opt.preconditioner,
                  "cg: jacobi, block-jacobi (each point's 3x3 block), ichol (incomplete "
@@ -439,8 +439,10 @@ int main(int argc, char** argv) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : kExitUsage;
   }
-  const auto linear = *jello::parseLinearSolver(opt.linearSolver);
-  opt.solver.implicit.linearSolver = opt.solver.cvode.linearSolver = linear;
+  if (!opt.linearSolver.empty()) {
+    const auto linear = *jello::parseLinearSolver(opt.linearSolver);
+    opt.solver.implicit.linearSolver = opt.solver.cvode.linearSolver = linear;
+  }
   opt.solver.implicit.preconditioner = opt.solver.cvode.preconditioner =
       *jello::parsePreconditioner(opt.preconditioner);
   opt.solver.implicit.matrixFree = opt.solver.cvode.matrixFree = !opt.csrProduct;
