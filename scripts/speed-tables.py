@@ -26,7 +26,7 @@ README = os.path.join(ROOT, "README.md")
 BINARY = os.path.join(ROOT, "build", "release", "bin", "benchmarks")
 FILTER = ("BM_SpringForces|BM_Step/|BM_Refill|BM_Factorize|BM_Solve/|BM_CgSolve|BM_SystemProduct|"
           "BM_ImplicitStep/|BM_StiffOneSecond")
-PRECONDITIONERS = ["jacobi", "block-jacobi", "ichol", "factor"]
+PRECONDITIONERS = ["jacobi", "block-jacobi", "ichol", "factor", "projective"]
 
 
 def run():
