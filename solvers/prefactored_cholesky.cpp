@@ -3,6 +3,7 @@
 #include <cholmod.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 namespace jello {
@@ -50,7 +51,11 @@ void substitute(int n, const std::vector<int>& rowStart, const std::vector<int>&
 struct PrefactoredCholesky::Impl {
   cholmod_common common{};
   cholmod_factor* symbolic = nullptr;  // analysis of the pattern, factored in place
-  bool copied = false;                 // solves run over the copy, not through CHOLMOD
+  // After update(): a simplicial LDL' copy of the factor, modified by cholmod_updown (which
+  // needs that form); the supernodal one stays for the next full factorization.
+  cholmod_factor* updated = nullptr;
+  bool copied = false;  // solves run over the copy, not through CHOLMOD
+  std::vector<int> inversePerm;
   std::vector<Lanes> lanes;
   std::vector<double> single;
   cholmod_dense* solution = nullptr;  // cholmod_solve2's outputs and work, kept between solves
@@ -66,6 +71,7 @@ struct PrefactoredCholesky::Impl {
     cholmod_free_dense(&solution, &common);
     cholmod_free_dense(&work1, &common);
     cholmod_free_dense(&work2, &common);
+    cholmod_free_factor(&updated, &common);
     cholmod_free_factor(&symbolic, &common);
     cholmod_finish(&common);
   }
@@ -78,6 +84,7 @@ PrefactoredCholesky::PrefactoredCholesky(long copyLimit)
 PrefactoredCholesky::~PrefactoredCholesky() = default;
 
 void PrefactoredCholesky::forgetPattern() {
+  cholmod_free_factor(&impl_->updated, &impl_->common);
   cholmod_free_factor(&impl_->symbolic, &impl_->common);
   n_ = 0;
 }
@@ -114,6 +121,7 @@ StepResult PrefactoredCholesky::factorize(const SparseMatrix& A) {
                                  std::to_string(s.common.status) + ")");
     }
   }
+  cholmod_free_factor(&s.updated, &s.common);  // a fresh factor: earlier updates are moot
   cholmod_factor* L = s.symbolic;
   if (!cholmod_factorize(&view, L, &s.common) || s.common.status != CHOLMOD_OK) {
     // CHOLMOD_NOT_POSDEF is a warning: the call "succeeds" with a partial factor.
@@ -164,6 +172,12 @@ StepResult PrefactoredCholesky::factorize(const SparseMatrix& A) {
       colStart_[static_cast<std::size_t>(j) + 1] = static_cast<int>(colRow_.size());
     }
   }
+  transposeCopy();
+  return StepResult::success();
+}
+
+void PrefactoredCholesky::transposeCopy() {
+  const int n = n_;
   rowStart_.assign(static_cast<std::size_t>(n) + 1, 0);
   for (int r : colRow_) ++rowStart_[static_cast<std::size_t>(r) + 1];
   for (int i = 0; i < n; ++i) rowStart_[i + 1] += rowStart_[i];
@@ -177,8 +191,96 @@ StepResult PrefactoredCholesky::factorize(const SparseMatrix& A) {
       rowValue_[at] = colValue_[q];
     }
   }
-  s.lanes.resize(static_cast<std::size_t>(n));
-  s.single.resize(static_cast<std::size_t>(n));
+  impl_->lanes.resize(static_cast<std::size_t>(n));
+  impl_->single.resize(static_cast<std::size_t>(n));
+}
+
+StepResult PrefactoredCholesky::addToDiagonal(const std::vector<std::pair<int, double>>& changes) {
+  Impl& s = *impl_;
+  if (!factored()) return StepResult::failure("prefactored Cholesky: no factor to update");
+  if (changes.empty()) return StepResult::success();
+  const int n = n_;
+  if (!s.updated) {
+    // A simplicial LDL' copy of the supernodal factor: the form cholmod_updown works on.
+    s.updated = cholmod_copy_factor(s.symbolic, &s.common);
+    if (!s.updated || s.common.status != CHOLMOD_OK ||
+        !cholmod_change_factor(CHOLMOD_REAL, false, false, false, true, s.updated, &s.common) ||
+        s.common.status != CHOLMOD_OK) {
+      cholmod_free_factor(&s.updated, &s.common);
+      return StepResult::failure("CHOLMOD could not convert the factor for an update");
+    }
+    const auto* perm = static_cast<const int*>(s.updated->Perm);
+    s.inversePerm.assign(static_cast<std::size_t>(n), 0);
+    for (int k = 0; k < n; ++k) s.inversePerm[static_cast<std::size_t>(perm[k])] = k;
+  }
+  // One column per changed point, sqrt(|delta|) at the point's row of the permuted matrix;
+  // the increases are an update, the decreases a downdate. Columns in row order, each sorted.
+  for (const bool increase : {true, false}) {
+    std::vector<std::pair<int, double>> entries;
+    for (const auto& [point, delta] : changes) {
+      if (delta == 0.0 || (delta > 0.0) != increase) continue;
+      entries.emplace_back(s.inversePerm[static_cast<std::size_t>(point)],
+                           std::sqrt(std::abs(delta)));
+    }
+    if (entries.empty()) continue;
+    std::sort(entries.begin(), entries.end());
+    const auto k = static_cast<int>(entries.size());
+    std::vector<int> columnStart(static_cast<std::size_t>(k) + 1),
+        rowIndex(static_cast<std::size_t>(k));
+    std::vector<double> value(static_cast<std::size_t>(k));
+    for (int c = 0; c < k; ++c) {
+      columnStart[static_cast<std::size_t>(c) + 1] = c + 1;
+      rowIndex[static_cast<std::size_t>(c)] = entries[static_cast<std::size_t>(c)].first;
+      value[static_cast<std::size_t>(c)] = entries[static_cast<std::size_t>(c)].second;
+    }
+    cholmod_sparse C{};
+    C.nrow = static_cast<size_t>(n);
+    C.ncol = static_cast<size_t>(k);
+    C.nzmax = static_cast<size_t>(k);
+    C.p = columnStart.data();
+    C.i = rowIndex.data();
+    C.x = value.data();
+    C.stype = 0;
+    C.itype = CHOLMOD_INT;
+    C.xtype = CHOLMOD_REAL;
+    C.dtype = CHOLMOD_DOUBLE;
+    C.sorted = 1;
+    C.packed = 1;
+    if (!cholmod_updown(increase, &C, s.updated, &s.common) || s.common.status != CHOLMOD_OK) {
+      const int status = s.common.status;
+      forgetPattern();
+      return StepResult::failure(status == CHOLMOD_NOT_POSDEF
+                                     ? "CHOLMOD: the downdated matrix is not positive definite"
+                                     : "CHOLMOD could not update the factor (status " +
+                                           std::to_string(status) + ")");
+    }
+  }
+  if (!s.copied) return StepResult::success();
+  // The copy from the simplicial LDL' factor, as LL': column j scaled by sqrt(D_j).
+  const cholmod_factor& L = *s.updated;
+  const auto* Lp = static_cast<const int*>(L.p);
+  const auto* Li = static_cast<const int*>(L.i);
+  const auto* Lnz = static_cast<const int*>(L.nz);
+  const auto* Lx = static_cast<const double*>(L.x);
+  colStart_.assign(static_cast<std::size_t>(n) + 1, 0);
+  colRow_.clear();
+  colValue_.clear();
+  for (int j = 0; j < n; ++j) {
+    const double d = Lx[Lp[j]];
+    if (!(d > 0.0)) {
+      forgetPattern();
+      return StepResult::failure("CHOLMOD: the updated matrix is not positive definite");
+    }
+    const double root = std::sqrt(d);
+    inverseDiagonal_[static_cast<std::size_t>(j)] = 1.0 / root;
+    for (int q = Lp[j] + 1; q < Lp[j] + Lnz[j]; ++q) {
+      if (Lx[q] == 0.0) continue;
+      colRow_.push_back(Li[q]);
+      colValue_.push_back(Lx[q] * root);
+    }
+    colStart_[static_cast<std::size_t>(j) + 1] = static_cast<int>(colRow_.size());
+  }
+  transposeCopy();
   return StepResult::success();
 }
 
@@ -220,8 +322,8 @@ StepResult PrefactoredCholesky::solveByCholmod(double* b, int columns) const {
   rhs.xtype = CHOLMOD_REAL;
   rhs.dtype = CHOLMOD_DOUBLE;
   // cholmod_solve2 reuses its output and work vectors once they have the right size.
-  if (!cholmod_solve2(CHOLMOD_A, s.symbolic, &rhs, nullptr, &s.solution, nullptr, &s.work1,
-                      &s.work2, &s.common) ||
+  if (!cholmod_solve2(CHOLMOD_A, s.updated ? s.updated : s.symbolic, &rhs, nullptr, &s.solution,
+                      nullptr, &s.work1, &s.work2, &s.common) ||
       s.common.status != CHOLMOD_OK) {
     return StepResult::failure("the CHOLMOD solve failed (status " +
                                std::to_string(s.common.status) + ")");

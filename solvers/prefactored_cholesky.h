@@ -11,6 +11,7 @@
 #pragma once
 
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "solvers/jacobian.h"
@@ -36,6 +37,12 @@ class PrefactoredCholesky {
   int size() const { return n_; }
   long nonZeros() const;  // entries of L, diagonal included
 
+  // A + diag(delta) in place of A, for the (point, delta) pairs given (a point at most once):
+  // CHOLMOD's rank-one updates (delta > 0) and downdates (delta < 0) of a simplicial copy of the
+  // factor (cholmod_updown), instead of a new factorization. The matrix must stay positive
+  // definite; a failure leaves no factor.
+  StepResult addToDiagonal(const std::vector<std::pair<int, double>>& changes);
+
   // Solves A X = B in place: b holds `columns` (1 to 3) right-hand sides of size() entries one
   // after the other, and receives the solutions. Fails only when CHOLMOD's own solve does
   // (large factors), with its status.
@@ -46,6 +53,7 @@ class PrefactoredCholesky {
   std::unique_ptr<Impl> impl_;
   long copyLimit_;
   StepResult solveByCholmod(double* b, int columns) const;
+  void transposeCopy();  // L by rows from L by columns
   int n_ = 0;
   long nonZeros_ = 0;
   std::vector<int> perm_;  // row k of the factor is point perm_[k]

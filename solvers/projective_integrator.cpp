@@ -14,6 +14,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// A contact change of at most this many points updates the factor (cholmod_updown) instead of
+// factoring afresh. Measured on 1 s of jello.w at 8^3: of 96 contact changes 82 became updates,
+// and the time spent on factors fell from 80 to 46 ms (limits 8, 64 and 128 within noise).
+constexpr int kUpdateLimit = 64;
+
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -92,8 +97,25 @@ StepResult ProjectiveIntegrator::factorChanged(double h) {
       continue;
     }
     if (!all && factorOf_[c] == c && weights_[c] == factoredWeights_[c]) continue;
-    laplacian_->form(inertia, 0.0, 1.0, weights_[c].data(), A_[c]);
     const auto start = Clock::now();
+    if (options_.updateFactors && !all && factorOf_[c] == c && factors_->llt[c].factored()) {
+      // Its own factor, for this h: a few points entered or left contact. Rank-one updates
+      // and downdates of the diagonal, when few enough to beat a new factorization.
+      changes_.clear();
+      for (int p = 0; p < n_; ++p) {
+        const double delta = weights_[c][p] - factoredWeights_[c][p];
+        if (delta != 0.0) changes_.emplace_back(p, delta);
+      }
+      if (static_cast<int>(changes_.size()) <= kUpdateLimit) {
+        const StepResult updated = factors_->llt[c].addToDiagonal(changes_);
+        factorSeconds_ += secondsSince(start);
+        ++updates_;
+        if (!updated.ok) return StepResult::failure("projective matrix: " + updated.message);
+        factoredWeights_[c] = weights_[c];
+        continue;
+      }
+    }
+    laplacian_->form(inertia, 0.0, 1.0, weights_[c].data(), A_[c]);
     // SPD by construction: M/h^2 > 0, L and W semidefinite.
     const StepResult factored = factors_->llt[c].factorize(A_[c]);
     factorSeconds_ += secondsSince(start);
@@ -166,6 +188,7 @@ std::vector<Statistic> ProjectiveIntegrator::statistics() const {
       {"projective_last_update_m", lastUpdate_},
       {"factorizations", static_cast<double>(factorizations_)},
       {"contact_set_changes", static_cast<double>(contactChanges_)},
+      {"factor_updates", static_cast<double>(updates_)},
       {"factor_time_s", factorSeconds_},
       {"solve_time_s", solveSeconds_},
   };

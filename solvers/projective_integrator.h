@@ -16,9 +16,10 @@
 // W_c diagonal: kc for each wall a point violates along coordinate c (its exact Hessian), and kc
 // for each plane or sphere contact on all three coordinates (kc I >= kc n n^T, so every
 // iteration still lowers the projective energy). A is factored with CHOLMOD once per scene and
-// step size, and again only for a coordinate whose contact set changed; the factor is shared
-// between coordinates whose matrices are equal. Spring and contact damping, the force field
-// and the user force are evaluated at the iterate (lagged one iteration): at the fixed point
+// step size, and again only for a coordinate whose contact set changed (a change of a few
+// points by CHOLMOD's rank-one updates and downdates of the factor, cholmod_updown); the factor
+// is shared between coordinates whose matrices are equal. Spring and contact damping, the force
+// field and the user force are evaluated at the iterate (lagged one iteration): at the fixed point
 // they are exactly where backward Euler evaluates them, so the iterations converge to the
 // `implicit` step, damping included (the lag converges because h c/(m + k h^2) << 1).
 // Options: iterations per step (10) and a tolerance (m): the iterations stop early when an
@@ -28,6 +29,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "solvers/integrator.h"
@@ -75,7 +77,8 @@ class ProjectiveIntegrator final : public Integrator {
   Eigen::MatrixXd delta_;  // n x 3, the update of each coordinate
   int lastIterations_ = 0;
   double lastUpdate_ = 0.0;
-  long steps_ = 0, iterations_ = 0, factorizations_ = 0, contactChanges_ = 0;
+  std::vector<std::pair<int, double>> changes_;  // a coordinate's changed contact weights
+  long steps_ = 0, iterations_ = 0, factorizations_ = 0, contactChanges_ = 0, updates_ = 0;
   double factorSeconds_ = 0.0, solveSeconds_ = 0.0;
 };
 

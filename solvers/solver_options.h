@@ -84,6 +84,9 @@ struct CvodeOptions {
 struct ProjectiveOptions {
   int iterations = 10;     // local/global iterations per step
   double tolerance = 0.0;  // m: stop when an update moves no coordinate more (0: never early)
+  // A contact change of a few points updates the factor (cholmod_updown); off: it always
+  // refactors (the tests compare the two).
+  bool updateFactors = true;
 };
 
 struct SolverOptions {

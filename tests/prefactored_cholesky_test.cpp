@@ -76,6 +76,36 @@ TEST_P(PrefactoredCholeskyBothWays, RefusesAMatrixThatIsNotPositiveDefinite) {
   EXPECT_EQ(factor.size(), bigger.numPoints());
 }
 
+// Rank-one updates and downdates of the diagonal (cholmod_updown) solve A + diag(delta) as a new
+// factorization would, over several rounds, and a full factorization afterwards starts afresh.
+TEST_P(PrefactoredCholeskyBothWays, UpdatesAndDowndatesTheDiagonal) {
+  const Model model(resampleCube(test::loadWorld("jello.w"), 6));
+  const int n = model.numPoints();
+  const SparseMatrix A = laplacianSystem(model, 3.0, 0.1);
+  PrefactoredCholesky factor(GetParam());
+  ASSERT_TRUE(factor.factorize(A).ok);
+  Eigen::MatrixXd dense(A);
+  for (int round = 0; round < 3; ++round) {
+    SCOPED_TRACE(round);
+    std::vector<std::pair<int, double>> changes;
+    for (int p = round; p < n; p += 17) {
+      const double delta = (p % 2 == 0) ? 50.0 : -1.0;  // stays positive definite
+      changes.emplace_back(p, delta);
+      dense(p, p) += delta;
+    }
+    ASSERT_TRUE(factor.addToDiagonal(changes).ok);
+    const Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, 3);
+    Eigen::MatrixXd X = B;
+    ASSERT_TRUE(factor.solve(X.data(), 3).ok);
+    EXPECT_LT((dense * X - B).norm(), 1e-11 * B.norm() * dense.norm());
+  }
+  ASSERT_TRUE(factor.factorize(A).ok);  // the original again, from scratch
+  const Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, 1);
+  Eigen::MatrixXd X = B;
+  ASSERT_TRUE(factor.solve(X.data(), 1).ok);
+  EXPECT_LT((Eigen::MatrixXd(A) * X - B).norm(), 1e-11 * B.norm() * dense.norm());
+}
+
 INSTANTIATE_TEST_SUITE_P(CopyAndCholmod, PrefactoredCholeskyBothWays,
                          testing::Values(PrefactoredCholesky::kDefaultCopyLimit, 0L));
 

@@ -101,8 +101,9 @@ BENCHMARK(BM_Solve)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond);
 
 // One CG solve of jello.w's system (dt = 0.01), warm-started as in a time step: last step's
 // answer, the right-hand side moved by 1%. Arguments: N, the preconditioner (0 jacobi, 1
-// block-jacobi, 2 ichol, 3 factor, 4 projective) and the product (1 matrix-free, 0 the sparse matrix). The
-// set-up (a preconditioner's factorization, the operator's gathering) is outside the timing.
+// block-jacobi, 2 ichol, 3 factor, 4 projective) and the product (1 matrix-free, 0 the sparse
+// matrix). The set-up (a preconditioner's factorization, the operator's gathering) is outside the
+// timing.
 void BM_CgSolve(benchmark::State& st) {
   System sys(static_cast<int>(st.range(0)));
   const auto pre = static_cast<PreconditionerKind>(st.range(1));
