@@ -66,6 +66,8 @@ def label(name):
 RUNS = [
     ("rk4", 1e-4, []),
     ("implicit", 0.01, []),
+    ("implicit", 0.01, ["--linear-solver", "cholmod"]),
+    ("implicit", 0.01, ["--preconditioner", "projective", "--newton-seed", "30"]),
     ("implicit-linear", 0.01, []),
     ("midpoint", 0.01, []),
     ("newmark", 0.01, []),
@@ -73,7 +75,8 @@ RUNS = [
     ("cvode", 0.01, ["--rtol", "1e-6"]),
     ("projective", 0.01, []),
 ]
-COLUMNS = ["integrator", "dt_s", "simulated_s", "steps", "energy_start_J", "energy_end_J",
+COLUMNS = ["integrator", "settings", "dt_s", "simulated_s", "steps", "energy_start_J",
+           "energy_end_J",
            "energy_kept", "angular_momentum_kept", "wall_time_s", "wall_time_per_step_ms",
            "newton_iterations_per_step", "newton_unconverged_steps", "factorizations", "diverged"]
 
@@ -94,6 +97,7 @@ def run(binary, integrator, dt, extra):
     solver = s.get("solver", {})
     return {
         "integrator": integrator,
+        "settings": " ".join(extra),
         "dt_s": dt,
         "simulated_s": s["simulated_time_s"],
         "steps": s["steps"],
@@ -126,6 +130,8 @@ def table_from_csv():
         newton = r["newton_iterations_per_step"]
         newton = f"{float(newton):.1f}" if newton else "n/a"
         name = f"`{r['integrator']}`"
+        if r.get("settings"):
+            name += f" `{r['settings']}`"
         if r["diverged"] not in ("", "0", "False", "false"):
             name += f" (diverged at t = {float(r['simulated_s']):.3g} s; figures there)"
         lines.append(f"| {name} | {float(r['dt_s']):g} | "

@@ -72,6 +72,24 @@ TEST(JelloSim, WritesTheFinalStateStatsAndTrace) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 11);  // header, steps 0..100 by 10
 }
 
+// --time that is not a whole number of steps: whole steps, past the time asked, and a note that
+// says so (never silently short of it).
+TEST(JelloSim, SaysWhenTheTimeIsNotAWholeNumberOfSteps) {
+  const Outcome r =
+      run(sim() + " " + world("jello.w") + " --integrator projective --dt 0.03 " + "--time 0.1");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output,
+                       "not a whole number of steps of 0.03 s: running 4 steps, to "
+                       "t = 0.12 s"))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, "simulated    0.12 s")) << r.output;
+  const Outcome exact = run(sim() + " " + world("jello.w") + " --steps 3 --dt 0.03");
+  EXPECT_FALSE(contains(exact.output, "whole number")) << exact.output;
+  const Outcome quiet = run(sim() + " " + world("jello.w") + " --dt 0.03 --time 0.1 " +
+                            "--integrator projective --quiet");
+  EXPECT_EQ(quiet.output, "");
+}
+
 TEST(JelloSim, ReportsDivergenceWithExitCodeThreeAndWritesNoWorld) {
   test::TempDir dir;
   SceneSpec spec;

@@ -159,6 +159,17 @@ int run(const Options& opt) {
     return kExitUsage;
   }
   const long total = static_cast<long>(wanted);
+  // --time not a multiple of dt: the run takes whole steps and ends past the time asked for
+  // (never short of it); say so, and by how much, before it starts.
+  if (!opt.steps && opt.time && !opt.quiet) {
+    const double end = sim.state().t + double(total) * dt, asked = sim.state().t + *opt.time;
+    if (std::abs(end - asked) > 1e-9 * std::max(1.0, std::abs(asked))) {
+      std::fprintf(stderr,
+                   "jello-sim: note: --time %g s is not a whole number of steps of %g s: running "
+                   "%ld steps, to t = %.9g s (%.3g s past)\n",
+                   *opt.time, dt, total, end, end - asked);
+    }
+  }
   const Energy start = sim.model().energy(sim.state());
   const jello::Vec3 startL = sim.model().angularMomentum(sim.state());
   const std::string name(jello::integratorName(sim.integratorKind()));
