@@ -29,10 +29,12 @@ FILTER = ("BM_SpringForces|BM_Step/|BM_Refill|BM_Factorize|BM_Solve/|BM_CgSolve|
 PRECONDITIONERS = ["jacobi", "block-jacobi", "ichol", "factor", "projective"]
 
 
-def run():
+def run(threads=True):
     env = dict(os.environ, OMP_THREAD_LIMIT="1", OPENBLAS_NUM_THREADS="1")
-    for prefix, name, out in [(["taskset", "-c", "0"], FILTER, JSON),
-                              ([], "BM_Threads", THREADS_JSON)]:
+    runs = [(["taskset", "-c", "0"], FILTER, JSON)]
+    if threads:
+        runs.append(([], "BM_Threads", THREADS_JSON))
+    for prefix, name, out in runs:
         tmp = out + ".tmp"
         subprocess.run(prefix + [BINARY, f"--benchmark_filter={name}",
                                  "--benchmark_repetitions=5" if not prefix else
@@ -181,9 +183,12 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--run", action="store_true", help="run the benchmarks first")
     parser.add_argument("--readme", action="store_true", help="rewrite the README tables")
+    parser.add_argument("--no-threads", action="store_true",
+                        help="with --run: keep speed_threads.json (its two-core run needs a "
+                             "machine whose second CPU is idle)")
     args = parser.parse_args()
     if args.run:
-        run()
+        run(threads=not args.no_threads)
     with open(JSON) as f:
         r = Results(json.load(f))
     with open(THREADS_JSON) as f:

@@ -138,8 +138,8 @@ StepResult ImplicitSystem::solveProjective(Eigen::VectorXd& v) const {
   return projective_->solve(v.data(), 3);
 }
 
-StepResult ImplicitSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double tolerance) {
-  return solver_.solve(rhs, x, tolerance);
+StepResult ImplicitSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) {
+  return solver_.solve(rhs, x);
 }
 
 void ImplicitSystem::appendStatistics(std::vector<Statistic>& out) const {

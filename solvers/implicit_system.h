@@ -45,9 +45,8 @@ class ImplicitSystem {
   StepResult factorize();
   // formMatrix(a, b), then factorize().
   StepResult factorize(double a, double b);
-  // x: on entry CG's initial guess, on return the solution of A x = rhs (CG: to relative
-  // residual `tolerance` when that is looser than its own).
-  StepResult solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, double tolerance = 0.0);
+  // x: on entry CG's initial guess, on return the solution of A x = rhs.
+  StepResult solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x);
 
   // The projective matrix P(a, b) = M + L(a c + b k) + C on each coordinate of the bound model
   // (solvers/spring_laplacian.h), factored when a, b or C changed: CG's projective

@@ -221,8 +221,7 @@ StepResult SpdSolver::setUpPreconditioner(const SparseMatrix& A) {
   return StepResult::success();
 }
 
-StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::VectorXd& x,
-                                         double relativeTolerance) {
+StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
   Impl& s = *impl_;
   const Eigen::Index n3 = b.size(), n = n3 / 3;
   if (x.size() != n3) x.setZero(n3);
@@ -269,7 +268,7 @@ StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::Vector
     s.lastIterations = 0;
     return StepResult::success();
   }
-  const double tolerance = relativeTolerance * bNorm;
+  const double tolerance = cgTolerance_ * bNorm;
   const long maxIterations = std::max<long>(10, 2 * n3);
   product(x, s.q);
   s.r = b - s.q;
@@ -353,13 +352,13 @@ StepResult SpdSolver::factorize(const SparseMatrix& A, const SystemOperator* op,
   return result;
 }
 
-StepResult SpdSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x, double tolerance) {
+StepResult SpdSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
   const auto start = Clock::now();
   Impl& s = *impl_;
   StepResult result = StepResult::success();
   if (kind_ == LinearSolverKind::Cg && !s.useLdlt) {
     s.indefinite = false;
-    result = conjugateGradients(b, x, std::max(tolerance, cgTolerance_));
+    result = conjugateGradients(b, x);
     // Not positive definite (possible only with the clamp off): LDLT until the next factorize,
     // as cholmod falls back.
     if (!result.ok && s.indefinite) {

@@ -78,9 +78,8 @@ class SpdSolver {
                        const PrefactoredCholesky* projective = nullptr);
   // The next factorize analyzes its matrix's pattern afresh (a new model).
   void forgetPattern();
-  // x: on entry the initial guess (cg), on return the solution. cg: to relative residual
-  // `tolerance` instead of the configured one when that is given and looser (inexact Newton).
-  StepResult solve(const Eigen::VectorXd& b, Eigen::VectorXd& x, double tolerance = 0.0);
+  // x: on entry the initial guess (cg), on return the solution.
+  StepResult solve(const Eigen::VectorXd& b, Eigen::VectorXd& x);
 
   LinearSolverKind kind() const { return kind_; }
   PreconditionerKind preconditioner() const { return preconditioner_; }
@@ -89,7 +88,7 @@ class SpdSolver {
  private:
   struct Impl;
   StepResult setUpPreconditioner(const SparseMatrix& A);
-  StepResult conjugateGradients(const Eigen::VectorXd& b, Eigen::VectorXd& x, double tolerance);
+  StepResult conjugateGradients(const Eigen::VectorXd& b, Eigen::VectorXd& x);
   LinearSolverKind kind_;
   PreconditionerKind preconditioner_ = PreconditionerKind::Jacobi;
   double cgTolerance_;
