@@ -346,7 +346,8 @@ int main(int argc, char** argv) {
                  "cg: jacobi, block-jacobi (each point's 3x3 block), ichol (incomplete "
                  "Cholesky), factor (a CHOLMOD factor of an earlier matrix, refreshed when CG "
                  "needs more than 10 iterations) or projective (the springs' Laplacian "
-                 "M + L(a c + b k), factored once per step size)")
+                 "M + L(a c + b k) with the contacts on its diagonal, factored once per step "
+                 "size and contact set)")
       ->check(CLI::IsMember({"jacobi", "block-jacobi", "ichol", "factor", "projective"}))
       ->capture_default_str()
       ->group(implicitGroup);
