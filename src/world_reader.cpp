@@ -409,24 +409,44 @@ World parseWorld(std::string_view text, const std::string& name, const ReaderLim
 
 World readWorld(const std::filesystem::path& path, const ReaderLimits& limits) {
   const std::string name = path.string();
+  namespace fs = std::filesystem;
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    throw WorldFileError(name, 0, name, "is a directory, not a world file");
-  }
-  const std::uintmax_t size = std::filesystem::file_size(path, ec);
-  if (ec) throw WorldFileError(name, 0, name, "cannot open: " + ec.message());
-  if (size > limits.maxFileBytes) {
+  const fs::file_status status = fs::status(path, ec);
+  if (ec || !fs::exists(status)) {
     throw WorldFileError(name, 0, name,
-                         "file is larger than the reader allows (" +
-                             std::to_string(limits.maxFileBytes) + " bytes)");
+                         "cannot open: " + (ec ? ec.message() : std::string("no such file")));
+  }
+  if (fs::is_directory(status))
+    throw WorldFileError(name, 0, name, "is a directory, not a world file");
+  if (fs::is_character_file(status) || fs::is_block_file(status) || fs::is_socket(status)) {
+    throw WorldFileError(name, 0, name,
+                         std::string("is a ") + (fs::is_socket(status) ? "socket" : "device") +
+                             ", not a world file (read from a regular file or a pipe)");
+  }
+  // A regular file too large is refused before anything is read. Pipes, and files such as
+  // /proc's whose size reads 0, are read to their end, refused as soon as they pass the limit.
+  if (fs::is_regular_file(status)) {
+    const std::uintmax_t size = fs::file_size(path, ec);
+    if (!ec && size > limits.maxFileBytes) {
+      throw WorldFileError(name, 0, name,
+                           "file is larger than the reader allows (" +
+                               std::to_string(limits.maxFileBytes) + " bytes)");
+    }
   }
   std::ifstream file(path, std::ios::binary);
   if (!file) throw WorldFileError(name, 0, name, "cannot open for reading");
-  std::string text(static_cast<std::size_t>(size), '\0');
-  file.read(text.data(), static_cast<std::streamsize>(size));
-  if (file.gcount() != static_cast<std::streamsize>(size)) {
-    throw WorldFileError(name, 0, name, "read failed");
+  std::string text;
+  std::vector<char> chunk(1 << 16);
+  while (file.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || file.gcount() > 0) {
+    const auto got = static_cast<std::size_t>(file.gcount());
+    if (text.size() + got > limits.maxFileBytes) {
+      throw WorldFileError(name, 0, name,
+                           "file is larger than the reader allows (" +
+                               std::to_string(limits.maxFileBytes) + " bytes)");
+    }
+    text.append(chunk.data(), got);
   }
+  if (file.bad()) throw WorldFileError(name, 0, name, "read failed");
   return parseWorld(text, name, limits);
 }
 

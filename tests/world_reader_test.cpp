@@ -2,10 +2,13 @@
 #include "src/world_reader.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
+#include <fstream>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "src/scene_builder.h"
@@ -311,6 +314,36 @@ TEST(WorldReader, ShowsBadTokensShortAndEscaped) {
 
 TEST(WorldReader, ReportsADirectory) {
   EXPECT_THROW((void)readWorld(test::worldsDir()), WorldFileError);
+}
+
+// Special inputs: a pipe is read to its end like a file (here written by a thread); a file of
+// /proc, whose size reads 0, is read too and refused for what it holds (not as "empty"); a
+// device is refused by name before anything is read.
+TEST(WorldReader, ReadsPipesAndProcFilesAndRefusesDevices) {
+  test::TempDir dir;
+  const auto fifo = dir.path() / "world.fifo";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  const std::string text = test::readFile(test::worldsDir() / "jello.w");
+  std::thread writer([&] {
+    std::ofstream out(fifo, std::ios::binary);
+    out << text;
+  });
+  const World fromPipe = readWorld(fifo);
+  writer.join();
+  EXPECT_EQ(fromPipe.positions, readWorld(test::worldsDir() / "jello.w").positions);
+  try {
+    (void)readWorld("/proc/self/status");
+    FAIL() << "accepted";
+  } catch (const WorldFileError& e) {
+    EXPECT_EQ(e.line(), 1);
+    EXPECT_EQ(std::string(e.what()).find("empty file"), std::string::npos) << e.what();
+  }
+  try {
+    (void)readWorld("/dev/null");
+    FAIL() << "accepted";
+  } catch (const WorldFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a device"), std::string::npos) << e.what();
+  }
 }
 
 TEST(WorldReader, ReadsPlaneFlagsOtherThanOneAsNoPlane) {
