@@ -61,6 +61,18 @@ struct SpdSolver::Impl {
     }
     return StepResult::success();
   }
+
+  // LDLT succeeds silently on singular or badly indefinite systems: the answer is checked.
+  StepResult solveLdlt(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+    x = ldlt.solve(b);
+    if (ldlt.info() != Eigen::Success) return StepResult::failure("the LDLT solve failed");
+    const double residual = (*A * x - b).norm(), scale = b.norm();
+    if (!(residual <= kResidualTolerance * scale)) {
+      return StepResult::failure("the LDLT solution is inaccurate (relative residual " +
+                                 std::to_string(residual / scale) + ")");
+    }
+    return StepResult::success();
+  }
 };
 
 namespace {
@@ -365,22 +377,10 @@ StepResult SpdSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
       ++stats_.fallbacks;
       result = s.factorLdlt(*s.A, stats_);
       s.useLdlt = result.ok;
+      if (result.ok) result = s.solveLdlt(b, x);
     }
-  }
-  if (!result.ok || (kind_ == LinearSolverKind::Cg && !s.useLdlt)) {
-    // solved by CG, or failed
   } else if (s.useLdlt) {
-    x = s.ldlt.solve(b);
-    if (s.ldlt.info() != Eigen::Success) {
-      result = StepResult::failure("the LDLT solve failed");
-    } else {
-      // LDLT succeeds silently on singular or badly indefinite systems: check the answer.
-      const double residual = (*s.A * x - b).norm(), scale = b.norm();
-      if (!(residual <= kResidualTolerance * scale)) {
-        result = StepResult::failure("the LDLT solution is inaccurate (relative residual " +
-                                     std::to_string(residual / scale) + ")");
-      }
-    }
+    result = s.solveLdlt(b, x);
   } else {
     x = s.llt.solve(b);
     if (s.llt.info() != Eigen::Success) result = StepResult::failure("the CHOLMOD solve failed");
