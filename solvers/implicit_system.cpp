@@ -23,22 +23,9 @@ void contactDiagonal(const Model& model, const double* x, double a, double b,
         if (std::abs(x[c * n + p]) > kBoxHalfSize) out[p] += w;
       }
   }
-  const auto& plane = model.plane();
-  const auto& sphere = model.sphere();
-  const auto& obstacles = model.obstacles();
-  if (!plane && !sphere && obstacles.empty()) return;
-  for (int p = 0; p < n; ++p) {
-    const Vec3 xp{x[p], x[n + p], x[2 * n + p]};
-    if (plane && dot(plane->normal(), xp) + plane->offset() < 0.0) {
-      out[p] += weight(plane->constants());
-    }
-    if (sphere && norm(xp - sphere->sphere().center) < sphere->sphere().radius) {
-      out[p] += weight(sphere->constants());
-    }
-    for (const ObstacleContact& o : obstacles) {
-      if (o.inside(xp)) out[p] += weight(o.constants());
-    }
-  }
+  if (!model.hasSolids()) return;
+  for (int p = 0; p < n; ++p)
+    out[p] += model.solidContactWeight({x[p], x[n + p], x[2 * n + p]}, weight);
 }
 
 }  // namespace

@@ -60,22 +60,10 @@ void ProjectiveIntegrator::contactWeights(const Model& model, const double* x) {
         if (std::abs(x[c * n + p]) > kBoxHalfSize) weights_[c][p] += kc;
       }
   }
-  const auto& plane = model.plane();
-  const auto& sphere = model.sphere();
-  const auto& obstacles = model.obstacles();
-  if (!plane && !sphere && obstacles.empty()) return;
+  if (!model.hasSolids()) return;
+  const auto stiffness = [](const ContactConstants& k) { return k.stiffness; };
   for (int p = 0; p < n; ++p) {
-    const Vec3 xp{x[p], x[n + p], x[2 * n + p]};
-    double w = 0.0;
-    if (plane && dot(plane->normal(), xp) + plane->offset() < 0.0) {
-      w += plane->constants().stiffness;
-    }
-    if (sphere && norm(xp - sphere->sphere().center) < sphere->sphere().radius) {
-      w += sphere->constants().stiffness;
-    }
-    for (const ObstacleContact& o : obstacles) {
-      if (o.inside(xp)) w += o.constants().stiffness;
-    }
+    const double w = model.solidContactWeight({x[p], x[n + p], x[2 * n + p]}, stiffness);
     for (int c = 0; c < 3; ++c) weights_[c][p] += w;
   }
 }

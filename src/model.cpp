@@ -148,18 +148,10 @@ bool Model::inContact(const double* x) const {
       if (std::abs(x[i]) > kBoxHalfSize) return true;
     }
   }
-  if (!plane_ && !sphere_ && obstacles_.empty()) return false;
+  if (!hasSolids()) return false;
+  const auto one = [](const ContactConstants&) { return 1.0; };
   for (int p = 0; p < n; ++p) {
-    if (insideSolid({x[p], x[n + p], x[2 * n + p]})) return true;
-  }
-  return false;
-}
-
-bool Model::insideSolid(const Vec3& x) const {
-  if (plane_ && dot(plane_->normal(), x) + plane_->offset() < 0.0) return true;
-  if (sphere_ && norm(x - sphere_->sphere().center) < sphere_->sphere().radius) return true;
-  for (const ObstacleContact& o : obstacles_) {
-    if (o.inside(x)) return true;
+    if (solidContactWeight({x[p], x[n + p], x[2 * n + p]}, one) > 0.0) return true;
   }
   return false;
 }

@@ -83,6 +83,24 @@ class Model {
   bool contactBegins(const double* x0, const double* x1) const;
   // True when some point is in contact (wall, plane, sphere or obstacle) at positions x.
   bool inContact(const double* x) const;
+  // Any plane, sphere or obstacle at all.
+  bool hasSolids() const { return plane_ || sphere_ || !obstacles_.empty(); }
+  // The contact constants of the plane, sphere and obstacles x is on the solid side of, each
+  // mapped by weight(const ContactConstants&) and summed (0 when it is inside none): the
+  // diagonal contact weights of the projective matrices (solvers/).
+  template <class Weight>
+  double solidContactWeight(const Vec3& x, const Weight& weight) const {
+    double w = 0.0;
+    if (plane_ && dot(plane_->normal(), x) + plane_->offset() < 0.0)
+      w += weight(plane_->constants());
+    if (sphere_ && norm(x - sphere_->sphere().center) < sphere_->sphere().radius) {
+      w += weight(sphere_->constants());
+    }
+    for (const ObstacleContact& o : obstacles_) {
+      if (o.inside(x)) w += weight(o.constants());
+    }
+    return w;
+  }
 
   // Work (J) the force field does on the points moving from x0 to x1 (3n each), by the
   // trapezoid rule along the straight path: sum of 1/2 (F(x0) + F(x1)) . (x1 - x0). Exact for
@@ -128,8 +146,6 @@ class Model {
   bool hasUserForce() const { return userForce_.has_value(); }
 
  private:
-  // x on the solid side of the plane, inside the sphere or inside an obstacle.
-  bool insideSolid(const Vec3& x) const;
   long id_;
   int n_;
   double mass_;
