@@ -40,7 +40,8 @@ def test_measured_thresholds_equal_jello_stability(integrator):
     result = jello.stability_threshold(world, integrator)
     row = committed("free", integrator, 1e4, "measured")
     assert result["outcome"] == row["outcome"] == "threshold"
-    assert result["stable"] == float(row["dt_s"])
+    # The same bisection: equal but for the last bits, which differ between CPUs.
+    assert result["stable"] == pytest.approx(float(row["dt_s"]), rel=1e-9)
     assert result["trials"] == int(row["trials"])
     assert result["stable"] < result["unstable"] <= 1.02 * result["stable"] * (1 + 1e-12)
 
