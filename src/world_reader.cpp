@@ -16,30 +16,96 @@ namespace {
 
 constexpr std::string_view kEndOfFile = "<end of file>";
 
+// A token as the reader keeps it: its first kMaxTokenBytes bytes (a longer one cannot be a
+// number or a keyword, and a 50 MB "number" is never held whole) and its full length.
+constexpr std::size_t kMaxTokenBytes = 4096;
 struct Token {
-  std::string_view text;  // empty at end of file
+  std::string text;  // empty at end of file
+  std::size_t bytes = 0;
   int line = 0;
 };
 
-// Whitespace-separated tokens with their line numbers. '\r' is white space, so CRLF files read
-// like LF files, as with the original fscanf loader.
+// Where the tokenizer's bytes come from: a text already in memory, or a stream read in chunks so
+// that a file is never held whole (refused early, in bounded memory).
+class ByteSource {
+ public:
+  virtual ~ByteSource() = default;
+  // Up to `n` bytes into `buf`; 0 at the end.
+  virtual std::size_t read(char* buf, std::size_t n) = 0;
+};
+
+class TextSource final : public ByteSource {
+ public:
+  explicit TextSource(std::string_view text) : text_(text) {}
+  std::size_t read(char* buf, std::size_t n) override {
+    const std::size_t got = std::min(n, text_.size());
+    std::copy_n(text_.data(), got, buf);
+    text_.remove_prefix(got);
+    return got;
+  }
+
+ private:
+  std::string_view text_;
+};
+
+class StreamSource final : public ByteSource {
+ public:
+  StreamSource(std::istream& in, std::string name) : in_(in), name_(std::move(name)) {}
+  std::size_t read(char* buf, std::size_t n) override {
+    in_.read(buf, static_cast<std::streamsize>(n));
+    if (in_.bad()) throw WorldFileError(name_, 0, name_, "read failed");
+    return static_cast<std::size_t>(in_.gcount());
+  }
+
+ private:
+  std::istream& in_;
+  std::string name_;
+};
+
+// Whitespace-separated tokens with their line numbers, read in 64 KiB chunks. '\r' is white
+// space, so CRLF files read like LF files, as with the original fscanf loader. `totalBytes` is
+// the input's size when known (0: unknown); `maxBytes` refuses a larger input once it is passed.
 class Tokenizer {
  public:
-  Tokenizer(std::string_view text, std::string name) : text_(text), name_(std::move(name)) {}
+  Tokenizer(ByteSource& source, std::string name, std::uintmax_t totalBytes,
+            std::uintmax_t maxBytes)
+      : source_(source), name_(std::move(name)), total_(totalBytes), max_(maxBytes) {
+    // A UTF-8 byte-order mark (some editors write one) is not part of the first token.
+    while (end_ < 3 && fill()) {
+    }
+    if (std::string_view(buffer_.data(), std::min<std::size_t>(end_, 3)) == "\xEF\xBB\xBF") {
+      pos_ = 3;
+    }
+  }
 
   Token next() {
     skipSpace();
-    const std::size_t start = pos_;
-    while (pos_ < text_.size() && !isSpace(text_[pos_])) ++pos_;
-    lastToken_ = {text_.substr(start, pos_ - start), line_};
+    lastToken_.text.clear();
+    lastToken_.bytes = 0;
+    lastToken_.line = line_;
+    while (pos_ < end_ || fill()) {
+      std::size_t stop = pos_;
+      while (stop < end_ && !isSpace(buffer_[stop])) ++stop;
+      const std::size_t n = stop - pos_;
+      const std::size_t keep = std::min(n, kMaxTokenBytes - lastToken_.text.size());
+      lastToken_.text.append(buffer_.data() + pos_, keep);
+      lastToken_.bytes += n;
+      pos_ = stop;
+      if (stop < end_) break;
+    }
     return lastToken_;
   }
 
-  std::size_t remainingBytes() const { return text_.size() - pos_; }
+  // Bytes not yet read, when the input's size is known; otherwise the largest possible count.
+  std::uintmax_t remainingBytes() const {
+    if (total_ == 0) return std::numeric_limits<std::uintmax_t>::max();
+    const std::uintmax_t used = consumed_ - (end_ - pos_);
+    return used < total_ ? total_ - used : 0;
+  }
 
   [[noreturn]] void fail(const Token& t, const std::string& message) const {
-    const std::string token = t.text.empty() ? std::string(kEndOfFile) : std::string(t.text);
-    throw WorldFileError(name_, t.line, token, message);
+    if (t.text.empty()) throw WorldFileError(name_, t.line, std::string(kEndOfFile), message);
+    throw WorldFileError(name_, t.line, t.text, message, t.bytes);
   }
 
   double number(const char* what) {
@@ -49,6 +115,7 @@ class Tokenizer {
 
   double toNumber(const Token& t, const char* what) const {
     if (t.text.empty()) fail(t, std::string("file ends where ") + what + " was expected");
+    if (t.bytes > t.text.size()) fail(t, std::string("expected a number for ") + what);
     std::string_view s = t.text;
     if (s.size() > 1 && s[0] == '+' && s[1] != '-') s.remove_prefix(1);  // fscanf accepts "+1"
     double value = 0.0;
@@ -70,7 +137,7 @@ class Tokenizer {
     if (s.size() > 1 && s[0] == '+' && s[1] != '-') s.remove_prefix(1);
     const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
     if (ec == std::errc::result_out_of_range) fail(t, std::string(what) + " is out of range");
-    if (ec != std::errc() || end != s.data() + s.size()) {
+    if (ec != std::errc() || end != s.data() + s.size() || t.bytes > t.text.size()) {
       fail(t, std::string("expected an integer for ") + what + hint);
     }
     return value;
@@ -96,18 +163,75 @@ class Tokenizer {
   static bool isSpace(char c) {
     return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f';
   }
+  // Refills the buffer (keeping nothing: tokens are copied out as they are read); false at the end.
+  bool fill() {
+    if (eof_) return false;
+    if (pos_ == end_) pos_ = end_ = 0;
+    const std::size_t got = source_.read(buffer_.data() + end_, buffer_.size() - end_);
+    if (got == 0) {
+      eof_ = true;
+      return false;
+    }
+    end_ += got;
+    consumed_ += got;
+    if (consumed_ > max_) {
+      throw WorldFileError(
+          name_, 0, name_,
+          "file is larger than the reader allows (" + std::to_string(max_) + " bytes)");
+    }
+    return true;
+  }
   void skipSpace() {
-    while (pos_ < text_.size() && isSpace(text_[pos_])) {
-      if (text_[pos_] == '\n') ++line_;
-      ++pos_;
+    while (pos_ < end_ || fill()) {
+      while (pos_ < end_ && isSpace(buffer_[pos_])) {
+        if (buffer_[pos_] == '\n') ++line_;
+        ++pos_;
+      }
+      if (pos_ < end_) return;
     }
   }
 
-  std::string_view text_;
+  ByteSource& source_;
   std::string name_;
-  std::size_t pos_ = 0;
+  std::uintmax_t total_;
+  std::uintmax_t max_;
+  std::vector<char> buffer_ = std::vector<char>(1 << 16);
+  std::size_t pos_ = 0, end_ = 0;
+  std::uintmax_t consumed_ = 0;
+  bool eof_ = false;
   int line_ = 1;
   Token lastToken_;
+};
+
+// The tokens of the positions and velocities, kept for error messages only: their line, length
+// and the bytes a message shows, packed in one string (1.5 million of them for a 64^3 cube).
+class TokenLog {
+ public:
+  void reserve(std::size_t n) { entries_.reserve(n); }
+  void add(const Token& t) {
+    const std::size_t keep = std::min(t.text.size(), kShownBytes);
+    entries_.push_back({static_cast<std::uint32_t>(shown_.size()),
+                        static_cast<std::uint32_t>(std::min<std::size_t>(t.bytes, UINT32_MAX)),
+                        static_cast<std::uint8_t>(keep), t.line});
+    shown_.append(t.text, 0, keep);
+  }
+  bool empty() const { return entries_.empty(); }
+  Token operator[](std::size_t i) const {
+    const Entry& e = entries_[i];
+    return {shown_.substr(e.offset, e.kept), e.bytes, e.line};
+  }
+  Token back() const { return (*this)[entries_.size() - 1]; }
+
+ private:
+  static constexpr std::size_t kShownBytes = 41;  // one more than a message shows
+  struct Entry {                                  // 16 bytes
+    std::uint32_t offset;
+    std::uint32_t bytes;
+    std::uint8_t kept;
+    int line;
+  };
+  std::vector<Entry> entries_;
+  std::string shown_;
 };
 
 std::string metres(double value) {
@@ -225,7 +349,8 @@ void readExtensions(Tokenizer& in, Token keyword, World& world, const ReaderLimi
 // their length and their UTF-8; only control bytes are escaped.
 constexpr std::size_t kShownTokenBytes = 40;
 std::string displayToken(std::string_view token, std::size_t limit = kShownTokenBytes,
-                         bool keepUtf8 = false) {
+                         bool keepUtf8 = false, std::size_t bytes = 0) {
+  bytes = std::max(bytes, token.size());
   std::string out;
   for (std::size_t i = 0; i < token.size() && i < limit; ++i) {
     const auto c = static_cast<unsigned char>(token[i]);
@@ -238,24 +363,24 @@ std::string displayToken(std::string_view token, std::size_t limit = kShownToken
       out += hex[c & 15];
     }
   }
-  if (token.size() > limit) {
-    out += "... (" + std::to_string(token.size()) + " bytes)";
+  if (bytes > limit) {
+    out += "... (" + std::to_string(bytes) + " bytes)";
   }
   return out;
 }
 
 WorldFileError::WorldFileError(std::string file, int line, std::string token,
-                               const std::string& message)
+                               const std::string& message, std::size_t tokenBytes)
     : std::runtime_error(displayToken(file, file.size(), true) + ":" + std::to_string(line) + ": " +
-                         message + " (at '" + displayToken(token) + "')"),
+                         message + " (at '" +
+                         displayToken(token, kShownTokenBytes, false, tokenBytes) + "')"),
       file_(std::move(file)),
       line_(line),
-      token_(displayToken(token)) {}
+      token_(displayToken(token, kShownTokenBytes, false, tokenBytes)) {}
 
-World parseWorld(std::string_view text, const std::string& name, const ReaderLimits& limits) {
-  // A UTF-8 byte-order mark (some editors write one) is not part of the first token.
-  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
-  Tokenizer in(text, name);
+namespace {
+
+World parseTokens(Tokenizer& in, const ReaderLimits& limits) {
   World w;
 
   const Token integrator = in.next();
@@ -309,12 +434,12 @@ World parseWorld(std::string_view text, const std::string& name, const ReaderLim
     const std::size_t nodes = static_cast<std::size_t>(res) * res * res;
     // Each of the 3*nodes numbers needs at least a digit and a separator: refuse before
     // allocating when the file cannot hold them.
-    if (in.remainingBytes() + 1 < nodes * 3 * 2) {
+    if (in.remainingBytes() < nodes * 3 * 2 - 1) {
       in.fail(resToken, "file is too short for a force field of resolution " + std::to_string(res) +
                             " (" + std::to_string(nodes) + " nodes)");
     }
     w.field.resolution = res;
-    w.field.forces.resize(nodes);
+    w.field.forces.resize(nodes);  // at most 128^3 nodes (50 MB), and the file holds them
     for (Vec3& f : w.field.forces) {
       f.x = in.number("force-field x");
       f.y = in.number("force-field y");
@@ -325,7 +450,7 @@ World parseWorld(std::string_view text, const std::string& name, const ReaderLim
   // Positions and velocities: their count depends on the cube resolution, which an extension
   // given after them may set, so collect numbers up to the first keyword.
   std::vector<double> values;
-  std::vector<Token> tokens;
+  TokenLog tokens;
   values.reserve(6 * 512);
   tokens.reserve(6 * 512);
   // The largest cube the limits allow bounds how many numbers can follow: refused at the first
@@ -345,7 +470,7 @@ World parseWorld(std::string_view text, const std::string& name, const ReaderLim
               "cube, sphere, cone, spiral)");
     }
     values.push_back(in.toNumber(t, "a position or velocity"));
-    tokens.push_back(t);
+    tokens.add(t);
     t = in.next();
   }
   readExtensions(in, t, w, limits);
@@ -356,7 +481,7 @@ World parseWorld(std::string_view text, const std::string& name, const ReaderLim
     const bool inPositions = values.size() < 3 * points;
     const std::string block = inPositions ? "positions" : "velocities";
     const std::size_t got = inPositions ? values.size() : values.size() - 3 * points;
-    const Token where{{}, tokens.empty() ? t.line : tokens.back().line};
+    const Token where{{}, 0, tokens.empty() ? t.line : tokens.back().line};
     in.fail(where, "truncated: " + std::to_string(got / 3) + " of " + std::to_string(points) + " " +
                        block + " (cube resolution " + std::to_string(w.cubeResolution) + ")");
   }
@@ -407,6 +532,15 @@ World parseWorld(std::string_view text, const std::string& name, const ReaderLim
   return w;
 }
 
+}  // namespace
+
+World parseWorld(std::string_view text, const std::string& name, const ReaderLimits& limits) {
+  TextSource source(text);
+  Tokenizer in(source, name, std::max<std::uintmax_t>(text.size(), 1),
+               std::numeric_limits<std::uintmax_t>::max());
+  return parseTokens(in, limits);
+}
+
 World readWorld(const std::filesystem::path& path, const ReaderLimits& limits) {
   const std::string name = path.string();
   namespace fs = std::filesystem;
@@ -425,9 +559,13 @@ World readWorld(const std::filesystem::path& path, const ReaderLimits& limits) {
   }
   // A regular file too large is refused before anything is read. Pipes, and files such as
   // /proc's whose size reads 0, are read to their end, refused as soon as they pass the limit.
+  // Either is read in chunks and never held whole: a file of endless numbers is refused at the
+  // first number no allowed cube could hold, in a few megabytes.
+  std::uintmax_t size = 0;
   if (fs::is_regular_file(status)) {
-    const std::uintmax_t size = fs::file_size(path, ec);
-    if (!ec && size > limits.maxFileBytes) {
+    size = fs::file_size(path, ec);
+    if (ec) size = 0;
+    if (size > limits.maxFileBytes) {
       throw WorldFileError(name, 0, name,
                            "file is larger than the reader allows (" +
                                std::to_string(limits.maxFileBytes) + " bytes)");
@@ -435,19 +573,9 @@ World readWorld(const std::filesystem::path& path, const ReaderLimits& limits) {
   }
   std::ifstream file(path, std::ios::binary);
   if (!file) throw WorldFileError(name, 0, name, "cannot open for reading");
-  std::string text;
-  std::vector<char> chunk(1 << 16);
-  while (file.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || file.gcount() > 0) {
-    const auto got = static_cast<std::size_t>(file.gcount());
-    if (text.size() + got > limits.maxFileBytes) {
-      throw WorldFileError(name, 0, name,
-                           "file is larger than the reader allows (" +
-                               std::to_string(limits.maxFileBytes) + " bytes)");
-    }
-    text.append(chunk.data(), got);
-  }
-  if (file.bad()) throw WorldFileError(name, 0, name, "read failed");
-  return parseWorld(text, name, limits);
+  StreamSource source(file, name);
+  Tokenizer in(source, name, size, limits.maxFileBytes);
+  return parseTokens(in, limits);
 }
 
 }  // namespace jello

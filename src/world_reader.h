@@ -26,7 +26,9 @@ struct ReaderLimits {
 
 class WorldFileError : public std::runtime_error {
  public:
-  WorldFileError(std::string file, int line, std::string token, const std::string& message);
+  // `tokenBytes`: the token's full length when `token` holds only its start (0: its own size).
+  WorldFileError(std::string file, int line, std::string token, const std::string& message,
+                 std::size_t tokenBytes = 0);
 
   const std::string& file() const { return file_; }
   int line() const { return line_; }  // 1-based; 0 when the file could not be opened

@@ -1,9 +1,12 @@
 // The reader against the six reference worlds and every class of bad input.
 #include "src/world_reader.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
+#include <csignal>
 #include <fstream>
 #include <optional>
 #include <sstream>
@@ -344,6 +347,73 @@ TEST(WorldReader, ReadsPipesAndProcFilesAndRefusesDevices) {
   } catch (const WorldFileError& e) {
     EXPECT_NE(std::string(e.what()).find("is a device"), std::string::npos) << e.what();
   }
+}
+
+// Peak resident memory of this process (kB), after resetting it when `reset` (Linux's clear_refs).
+long peakResidentKb(bool reset) {
+  if (reset) std::ofstream("/proc/self/clear_refs") << "5";
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::stol(line.substr(6));
+  }
+  return -1;
+}
+
+// Huge inputs are read in chunks and refused early, in bounded memory: a 200 MB file whose
+// velocities are followed by one giant token (a sparse file of NUL bytes), and a pipe of endless
+// numbers, refused at the first number no allowed cube could hold. The whole-text reader used
+// about 22x (later 1x) the file in memory and read every byte first.
+TEST(WorldReader, RefusesHugeInputsEarlyInBoundedMemory) {
+  test::TempDir dir;
+  const std::string text = test::readFile(test::worldsDir() / "jello.w");
+  const auto big = dir.path() / "big.w";
+  std::ofstream(big, std::ios::binary) << text;
+  std::filesystem::resize_file(big, 200u << 20);
+  const long before = peakResidentKb(true);
+  ASSERT_GT(before, 0);
+  try {
+    (void)readWorld(big);
+    FAIL() << "accepted";
+  } catch (const WorldFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown trailing content"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("bytes)"), std::string::npos) << e.what();
+    EXPECT_LT(std::string(e.what()).size(), 400u);
+  }
+  EXPECT_LT(peakResidentKb(false) - before, 32 * 1024) << "kB above the peak before reading";
+
+  const auto fifo = dir.path() / "endless.fifo";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  std::signal(SIGPIPE, SIG_IGN);  // the writer sees EPIPE when the reader stops
+  long written = 0;
+  std::thread writer([&] {
+    const int fd = ::open(fifo.c_str(), O_WRONLY);
+    if (fd < 0) return;
+    std::string chunk = text;
+    for (int i = 0; i < 4096; ++i) chunk += "1.25 ";
+    while (written < (1L << 30)) {
+      const ssize_t n = ::write(fd, chunk.data(), chunk.size());
+      if (n <= 0) break;
+      written += n;
+      chunk = chunk.substr(chunk.size() - 4096 * 5);  // numbers only after the first world
+    }
+    ::close(fd);
+  });
+  const long beforePipe = peakResidentKb(true);
+  try {
+    (void)readWorld(fifo);
+    FAIL() << "accepted";
+  } catch (const WorldFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("more numbers than the positions and velocities"),
+              std::string::npos)
+        << e.what();
+  }
+  const long peak = peakResidentKb(false) - beforePipe;
+  writer.join();
+  std::signal(SIGPIPE, SIG_DFL);
+  EXPECT_LT(peak, 96 * 1024) << "kB above the peak before reading";
+  // 6 * 64^3 numbers of 5 bytes are about 8 MB: the rest of the pipe was never read.
+  EXPECT_LT(written, 64L << 20);
 }
 
 TEST(WorldReader, ReadsPlaneFlagsOtherThanOneAsNoPlane) {
