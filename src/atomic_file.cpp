@@ -4,8 +4,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <array>
+#include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <cstring>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -17,13 +21,82 @@ namespace {
                            std::strerror(err));
 }
 
+// Temporary files being written, for a fatal signal to remove (async-signal-safe: fixed slots,
+// each published by an atomic flag once its name is in place).
+constexpr std::size_t kSlots = 8;
+constexpr std::size_t kNameBytes = 4096;
+struct Slot {
+  std::atomic<bool> used{false};
+  std::atomic<bool> ready{false};
+  char name[kNameBytes] = {};
+};
+std::array<Slot, kSlots> slots;
+
+constexpr std::array<int, 3> kFatalSignals = {SIGINT, SIGTERM, SIGHUP};
+
+// Removes every registered temporary file, then dies of the signal as it would have.
+extern "C" void removeTemporariesAndDie(int signo) {
+  for (Slot& slot : slots) {
+    if (slot.ready.load()) ::unlink(slot.name);
+  }
+  std::signal(signo, SIG_DFL);
+  std::raise(signo);
+}
+
+// While any file is being written, SIGINT, SIGTERM and SIGHUP whose action is the default (to
+// die) remove the temporary files first. A program's own handlers (jello-sim stops and still
+// writes its outputs) are left alone.
+class CleanupOnSignals {
+ public:
+  CleanupOnSignals() {
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (users++ > 0) return;
+    for (std::size_t i = 0; i < kFatalSignals.size(); ++i) {
+      struct sigaction current {};
+      installed[i] = ::sigaction(kFatalSignals[i], nullptr, &current) == 0 &&
+                     !(current.sa_flags & SA_SIGINFO) && current.sa_handler == SIG_DFL &&
+                     std::signal(kFatalSignals[i], removeTemporariesAndDie) != SIG_ERR;
+    }
+  }
+  ~CleanupOnSignals() {
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (--users > 0) return;
+    for (std::size_t i = 0; i < kFatalSignals.size(); ++i) {
+      if (installed[i]) std::signal(kFatalSignals[i], SIG_DFL);
+    }
+  }
+  CleanupOnSignals(const CleanupOnSignals&) = delete;
+  CleanupOnSignals& operator=(const CleanupOnSignals&) = delete;
+
+ private:
+  static inline std::mutex mutex;
+  static inline int users = 0;
+  static inline std::array<bool, kFatalSignals.size()> installed = {};
+};
+
 // Closes and removes the temporary file unless it was renamed into place.
 class TempFile {
  public:
-  explicit TempFile(std::string name) : name_(std::move(name)) { fd_ = ::mkstemp(name_.data()); }
+  explicit TempFile(std::string name) : name_(std::move(name)) {
+    fd_ = ::mkstemp(name_.data());
+    if (fd_ < 0 || name_.size() >= kNameBytes) return;
+    for (Slot& slot : slots) {
+      bool expected = false;
+      if (slot.used.compare_exchange_strong(expected, true)) {
+        std::memcpy(slot.name, name_.c_str(), name_.size() + 1);
+        slot.ready.store(true);
+        slot_ = &slot;
+        break;
+      }
+    }
+  }
   ~TempFile() {
     if (fd_ >= 0) ::close(fd_);
     if (!committed_) ::unlink(name_.c_str());
+    if (slot_ != nullptr) {
+      slot_->ready.store(false);
+      slot_->used.store(false);
+    }
   }
   TempFile(const TempFile&) = delete;
   TempFile& operator=(const TempFile&) = delete;
@@ -41,6 +114,7 @@ class TempFile {
   std::string name_;
   int fd_ = -1;
   bool committed_ = false;
+  Slot* slot_ = nullptr;
 };
 
 void writeAll(const std::filesystem::path& path, int fd, std::string_view contents) {
@@ -89,6 +163,10 @@ std::filesystem::path followLinks(const std::filesystem::path& path) {
 
 }  // namespace
 
+namespace testing {
+void (*afterTemporaryCreated)() = nullptr;
+}  // namespace testing
+
 void writeFileAtomically(const std::filesystem::path& path, std::string_view contents) {
   struct stat existing {};
   const bool exists = ::stat(path.c_str(), &existing) == 0;  // follows links
@@ -100,8 +178,10 @@ void writeFileAtomically(const std::filesystem::path& path, std::string_view con
   }
   const std::filesystem::path target = followLinks(path);
 
+  const CleanupOnSignals cleanup;
   TempFile tmp(target.string() + ".tmp.XXXXXX");
   if (tmp.fd() < 0) fail(path, "cannot create a temporary file beside it", errno);
+  if (testing::afterTemporaryCreated != nullptr) testing::afterTemporaryCreated();
   if (exists) {
     if (::fchmod(tmp.fd(), existing.st_mode & 07777) != 0) fail(path, "fchmod", errno);
     if (::geteuid() == 0 && ::fchown(tmp.fd(), existing.st_uid, existing.st_gid) != 0) {

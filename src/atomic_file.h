@@ -11,6 +11,10 @@
 //   anything else       a device, FIFO or socket (/dev/null, /dev/stdout to a pipe) is written
 //                       in place, without a rename: never replaced by a regular file
 //   a directory         refused
+//
+// SIGINT, SIGTERM or SIGHUP arriving during a write, in a program that leaves them at their
+// default action, removes the temporary file before the program dies (a program that handles
+// them itself, like jello-sim, finishes the write).
 #pragma once
 
 #include <filesystem>
@@ -26,5 +30,10 @@ void writeFileAtomically(const std::filesystem::path& path, std::string_view con
 // (an empty path, a directory, a missing or unwritable directory, an unwritable special file),
 // or an empty string: for programs to check every output before a long run.
 std::string outputProblem(const std::filesystem::path& path);
+
+namespace testing {
+// Called, when set, right after the temporary file is created: a test raises a signal there.
+extern void (*afterTemporaryCreated)();
+}  // namespace testing
 
 }  // namespace jello

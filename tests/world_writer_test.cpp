@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
+#include <csignal>
 #include <cstring>
 #include <limits>
 #include <random>
@@ -245,6 +247,42 @@ TEST(AtomicFile, KeepsTheReplacedFilesPermissions) {
   ASSERT_EQ(::stat(path.c_str(), &st), 0);
   EXPECT_EQ(st.st_mode & 07777, 0640u);
   EXPECT_EQ(test::readFile(path), "new");
+}
+
+// Ctrl-C (or SIGTERM, SIGHUP) in the middle of a write, in a program that leaves the signal at
+// its default action: the program dies of it as before, but its temporary file is removed and
+// the previous file stays whole. The signal is raised right after the temporary file exists.
+TEST(AtomicFile, AFatalSignalDuringAWriteLeavesNoTemporaryFile) {
+  for (const int signo : {SIGINT, SIGTERM, SIGHUP}) {
+    test::TempDir dir;
+    const auto path = dir.path() / "out.w";
+    writeFileAtomically(path, "old");
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      static int raised = 0;
+      raised = signo;
+      testing::afterTemporaryCreated = [] { std::raise(raised); };
+      try {
+        writeFileAtomically(path, std::string(1 << 20, 'x'));
+      } catch (...) {
+      }
+      ::_exit(0);  // not reached: the signal kills the child
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "signal " << signo << ": status " << status;
+    EXPECT_EQ(WTERMSIG(status), signo);
+    EXPECT_EQ(test::readFile(path), "old");
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()),
+                            std::filesystem::directory_iterator{}),
+              1)
+        << "a temporary file was left after signal " << signo;
+  }
+  // Default actions are restored after the write.
+  struct sigaction action {};
+  ASSERT_EQ(::sigaction(SIGTERM, nullptr, &action), 0);
+  EXPECT_EQ(action.sa_handler, SIG_DFL);
 }
 
 TEST(AtomicFile, RefusesADirectory) {
