@@ -107,7 +107,7 @@ StepResult ImplicitSystem::factorProjective(double a, double b, const Eigen::Vec
   ++projectiveFactorizations_;
   if (!result.ok) {
     projectiveA_ = projectiveB_ = -1.0;
-    return StepResult::failure("the projective matrix: " + result.message);
+    return result.within("the projective matrix");
   }
   projectiveA_ = a;
   projectiveB_ = b;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "solvers/blas_headroom.h"
 #include "solvers/prefactored_cholesky.h"
 #include "solvers/system_operator.h"
 
@@ -215,6 +216,9 @@ StepResult SpdSolver::setUpPreconditioner(const SparseMatrix& A) {
         if (s.llt.info() != Eigen::Success) return StepResult::failure("CHOLMOD analysis failed");
         s.lltAnalyzed = true;
       }
+      if (const std::string why = blasHeadroomProblem(); !why.empty()) {
+        return StepResult::resourceFailure(why);
+      }
       s.llt.factorize(A);
       ++stats_.preconditionerFactorizations;
       s.lastIterations = 0;
@@ -341,6 +345,10 @@ StepResult SpdSolver::factorize(const SparseMatrix& A, const SystemOperator* op,
           break;
         }
         s.lltAnalyzed = true;
+      }
+      if (const std::string why = blasHeadroomProblem(); !why.empty()) {
+        result = StepResult::resourceFailure(why);
+        break;
       }
       s.llt.factorize(A);
       if (s.llt.info() == Eigen::Success) break;

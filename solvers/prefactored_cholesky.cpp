@@ -6,6 +6,8 @@
 #include <cmath>
 #include <string>
 
+#include "solvers/blas_headroom.h"
+
 namespace jello {
 namespace {
 
@@ -123,6 +125,9 @@ StepResult PrefactoredCholesky::factorize(const SparseMatrix& A) {
   }
   cholmod_free_factor(&s.updated, &s.common);  // a fresh factor: earlier updates are moot
   cholmod_factor* L = s.symbolic;
+  if (const std::string why = blasHeadroomProblem(); !why.empty()) {
+    return StepResult::resourceFailure(why);
+  }
   if (!cholmod_factorize(&view, L, &s.common) || s.common.status != CHOLMOD_OK) {
     // CHOLMOD_NOT_POSDEF is a warning: the call "succeeds" with a partial factor.
     const int status = s.common.status;

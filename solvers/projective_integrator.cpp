@@ -98,7 +98,7 @@ StepResult ProjectiveIntegrator::factorChanged(double h) {
         const StepResult updated = factors_->llt[c].addToDiagonal(changes_);
         factorSeconds_ += secondsSince(start);
         ++updates_;
-        if (!updated.ok) return StepResult::failure("projective matrix: " + updated.message);
+        if (!updated.ok) return updated.within("projective matrix");
         factoredWeights_[c] = weights_[c];
         continue;
       }
@@ -108,7 +108,7 @@ StepResult ProjectiveIntegrator::factorChanged(double h) {
     const StepResult factored = factors_->llt[c].factorize(A_[c]);
     factorSeconds_ += secondsSince(start);
     ++factorizations_;
-    if (!factored.ok) return StepResult::failure("projective matrix: " + factored.message);
+    if (!factored.ok) return factored.within("projective matrix");
     factoredWeights_[c] = weights_[c];
     factorOf_[c] = c;
   }

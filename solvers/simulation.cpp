@@ -76,6 +76,16 @@ StepResult Simulation::step() {
                  "the state handed to a step is finite");
   previous_ = state_;
   StepResult result = integrator_->step(model_, state_, dt_);
+  if (result.resource) {
+    // Nothing diverged: the step could not run here (a resource limit); the state is its start.
+    state_ = previous_;
+    integrator_->restart();
+    std::ostringstream os;
+    os << "stopped at t = " << state_.t << " s, step " << steps_ + 1 << ", integrator "
+       << integratorName(integrator_->kind()) << ": " << result.message;
+    result.message = os.str();
+    return result;
+  }
   if (result.interrupted) {
     // Asked to stop inside the step: nothing diverged; the state is the step's start, and the
     // integrator starts afresh if stepped again (its step was cut short).

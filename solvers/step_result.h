@@ -11,10 +11,22 @@ struct [[nodiscard]] StepResult {
   // Not a failure of the numerics: a stop was requested (src/interrupt.h) inside the step,
   // which left the state as it was before the step.
   bool interrupted = false;
+  // Not a failure of the numerics either: a resource the step needs is missing (the
+  // address-space limit leaves the BLAS no room); the state is left as it was before the step.
+  bool resource = false;
 
   static StepResult success() { return {}; }
   static StepResult failure(std::string why) { return {false, std::move(why), false}; }
   static StepResult interruption() { return {false, "interrupted", true}; }
+  static StepResult resourceFailure(std::string why) {
+    return {false, std::move(why), false, true};
+  }
+  // The same result, its message prefixed with what failed.
+  StepResult within(const std::string& what) const {
+    StepResult r = *this;
+    r.message = what + ": " + message;
+    return r;
+  }
 };
 
 }  // namespace jello

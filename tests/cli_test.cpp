@@ -203,6 +203,37 @@ TEST(JelloSim, RunningOutOfMemoryIsAClearErrorNotAnAbort) {
 #endif
 }
 
+// OpenBLAS, under CHOLMOD's supernodal factorizations (the cholmod linear solver, projective),
+// retries its 128 MiB buffer forever, deaf to SIGTERM, when an address-space limit leaves no
+// room: the factorization refuses first, naming the limit (exit 1, not "diverged", no world).
+TEST(JelloSim, AnAddressSpaceLimitTooTightForTheBlasIsReportedNotAHang) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer reserves more address space than the limit allows";
+#else
+  test::TempDir dir;
+  for (const char* how :
+       {"--integrator implicit --linear-solver cholmod", "--integrator projective"}) {
+    const auto out = dir.path() / "out.w";
+    const auto start = std::chrono::steady_clock::now();
+    const Outcome r =
+        run("bash -c 'ulimit -v 150000; OPENBLAS_NUM_THREADS=1 timeout -s KILL 60 " + sim() + " " +
+            world("jello.w") + " " + how + " --steps 3 --out " + out.string() + "'");
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(r.code, 1) << how << "\n" << r.output;
+    EXPECT_LT(seconds, 30.0) << how;
+    EXPECT_TRUE(contains(r.output, "the address-space limit (ulimit -v 150000 kB)")) << r.output;
+    EXPECT_TRUE(contains(r.output, "--linear-solver cg")) << r.output;
+    EXPECT_FALSE(contains(r.output, "diverged")) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(out)) << how;
+  }
+  // The default matrix-free CG needs no BLAS and runs under the same limit.
+  const Outcome cg = run("bash -c 'ulimit -v 150000; OPENBLAS_NUM_THREADS=1 timeout -s KILL 60 " +
+                         sim() + " " + world("jello.w") + " --integrator implicit --steps 3 -q'");
+  EXPECT_EQ(cg.code, 0) << cg.output;
+#endif
+}
+
 TEST(JelloSim, SigtermInsideOneLongStepStopsWithinASecond) {
   // One output interval of cvode (--dt 5, rtol 1e-9) on the stiff cube takes minutes, and so
   // does one projective step of 100,000 iterations: SIGTERM after one second must stop either

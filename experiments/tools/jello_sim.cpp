@@ -1,7 +1,8 @@
 // jello-sim: steps a world headless and reports what happened.
 //   jello-sim WORLD [--integrator NAME] [--dt S] [--time S | --steps N] [--cube N]
 //             [--out FILE.w] [--trace FILE.csv --every K] [--stats FILE.json] [--quiet]
-// Exit codes: 0 done, 1 bad input or an I/O failure, 2 bad usage, 3 the simulation diverged,
+// Exit codes: 0 done, 1 bad input, an I/O failure or a step that cannot run here (a memory limit),
+// 2 bad usage, 3 the simulation diverged,
 // 128 + signal when interrupted by SIGINT, SIGTERM or SIGHUP (it stops at a step boundary).
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -179,12 +180,14 @@ int run(const Options& opt) {
   jello::Progress progress(!opt.quiet, name + " steps");
   const auto t0 = std::chrono::steady_clock::now();
   bool diverged = false;
+  std::string failure;  // a step that could not run (a resource limit), not a divergence
   // SIGHUP (the terminal closed) stops like SIGTERM: the stats and the trace are written.
   for (int signo : {SIGINT, SIGTERM, SIGHUP})
     jello::setSignalHandler("jello-sim", signo, onInterrupt);
   for (long i = 0; i < total && interruptSignal == 0; ++i) {
     if (const jello::StepResult r = sim.step(); !r.ok) {
-      diverged = !r.interrupted;  // a stop inside a step leaves the state at its start
+      if (r.resource) failure = r.message;
+      diverged = !r.interrupted && !r.resource;  // both leave the state at the step's start
       break;
     }
     if (sim.steps() % opt.every == 0) trace.row(sim);
@@ -231,6 +234,10 @@ int run(const Options& opt) {
     std::fprintf(stderr, "jello-sim: interrupted (signal %d) at t = %g s, after step %ld of %ld\n",
                  interrupted, s.t, done, total);
   }
+  if (!failure.empty()) {
+    stats["failure"] = failure;
+    std::fprintf(stderr, "jello-sim: error: %s\n", failure.c_str());
+  }
   if (diverged) {
     const jello::Divergence& d = *sim.divergence();
     stats["divergence"] = {{"time_s", d.time}, {"step", d.step}, {"reason", d.reason}};
@@ -242,9 +249,10 @@ int run(const Options& opt) {
                 sim.model().springs().numSprings());
     std::printf("integrator   %s, dt = %g s\n", name.c_str(), dt);
     std::printf("steps        %ld%s\n", done,
-                diverged      ? " (then diverged)"
-                : interrupted ? " (interrupted)"
-                              : "");
+                diverged           ? " (then diverged)"
+                : interrupted      ? " (interrupted)"
+                : !failure.empty() ? " (then stopped: see the error above)"
+                                   : "");
     std::printf("simulated    %.6g s\n", s.t);
     std::printf("wall time    %.3f s (%.0f steps/s, %.2fx real time)\n", wall,
                 wall > 0 ? double(done) / wall : 0.0, wall > 0 ? s.t / wall : 0.0);
@@ -274,14 +282,17 @@ int run(const Options& opt) {
   }
   // A diverged or interrupted run saves no world: its last state is not the state at the
   // requested time. Its trace and stats are complete up to where it stopped, and say so.
-  if (!opt.out.empty() && !diverged && !interrupted) {
+  if (!opt.out.empty() && !diverged && !interrupted && failure.empty()) {
     attempt([&] { jello::writeWorld(sim.currentWorld(), opt.out); });
   }
   if (writeFailed) return kExitInput;
-  if ((diverged || interrupted) && !opt.out.empty()) {
+  if ((diverged || interrupted || !failure.empty()) && !opt.out.empty()) {
     std::fprintf(stderr, "jello-sim: %s not written (the simulation %s)\n", opt.out.c_str(),
-                 diverged ? "diverged" : "was interrupted");
+                 diverged      ? "diverged"
+                 : interrupted ? "was interrupted"
+                               : "could not go on");
   }
+  if (!failure.empty()) return kExitInput;
   if (interrupted) return 128 + interrupted;
   return diverged ? kExitDiverged : 0;
 }
@@ -300,7 +311,8 @@ int main(int argc, char** argv) {
       "Steps a jello world headless and prints a summary: steps, simulated and wall time, "
       "steps/s, real-time factor, energy at start and end, and the solver's statistics. For "
       "cvode, --dt is the output interval; CVODE chooses its own internal steps.\n"
-      "Exit codes: 0 done, 1 bad world file or I/O failure, 2 bad usage, 3 diverged, "
+      "Exit codes: 0 done, 1 bad world file, I/O failure or a memory limit too tight, 2 bad usage, "
+      "3 diverged, "
       "128+N interrupted by signal N (Ctrl-C: 130; trace and stats are written, --out is not).",
       "jello-sim"};
   app.add_option("world", opt.world, "World file (.w)")->required();
