@@ -234,6 +234,32 @@ TEST(JelloSim, AnAddressSpaceLimitTooTightForTheBlasIsReportedNotAHang) {
 #endif
 }
 
+// CVODE follows a lightly damped stiff mode at its tolerance: jello.w at k = 1e7 costs about 35
+// minutes a simulated second (scripts/cvode-stiff.py). jello-sim says so before it starts, with
+// its estimate; jello.w itself (k = 200) and the same stiff scene damped past critical (zeta > 1,
+// which BDF steps over) get no warning.
+TEST(JelloSim, WarnsBeforeAnHourOfCvodeOnALightlyDampedStiffScene) {
+  test::TempDir dir;
+  World w = readWorld(world("jello.w"));
+  w.kElastic = 1e7;
+  const auto stiff = dir.path() / "k1e7.w", damped = dir.path() / "damped.w";
+  writeWorld(w, stiff);
+  w.dElastic = 100.0;  // zeta = d w_max / 2k = 1.46
+  writeWorld(w, damped);
+  const std::string cvode = " --integrator cvode --time 1";
+  const Outcome r = run("timeout -s TERM 3 " + sim() + " " + stiff.string() + cvode);
+  EXPECT_TRUE(
+      contains(r.output, "warning: cvode follows this scene's fastest mode (w_max = 2.91e+05"))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, "expect about 4.2e+06 internal steps for 1 simulated s"))
+      << r.output;
+  for (const std::string& quiet : {world("jello.w"), damped.string()}) {
+    const Outcome q = run("timeout -s TERM 3 " + sim() + " " + quiet + cvode);
+    EXPECT_TRUE(contains(q.output, "integrator   cvode")) << q.output;  // the summary: it ran
+    EXPECT_FALSE(contains(q.output, "warning")) << quiet << "\n" << q.output;
+  }
+}
+
 TEST(JelloSim, SigtermInsideOneLongStepStopsWithinASecond) {
   // One output interval of cvode (--dt 5, rtol 1e-9) on the stiff cube takes minutes, and so
   // does one projective step of 100,000 iterations: SIGTERM after one second must stop either

@@ -1,8 +1,5 @@
 #include "experiments/studies/stability_analysis.h"
 
-#include <Spectra/MatOp/SparseSymMatProd.h>
-#include <Spectra/SymEigsSolver.h>
-
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <complex>
@@ -15,23 +12,6 @@
 #include "src/scene_builder.h"
 
 namespace jello::experiments {
-
-double maxAngularFrequency(const Model& model, const State& state) {
-  JacobianAssembler jacobian(model);
-  jacobian.assemble(state.x.data(), {.clampCompression = false});
-  const SparseMatrix stiffness = -jacobian.K() / model.mass();
-  Spectra::SparseSymMatProd<double> op(stiffness);
-  // Spectra wants ncv > nev; 20 Lanczos vectors converge the top eigenvalue in a few restarts.
-  Spectra::SymEigsSolver<Spectra::SparseSymMatProd<double>> eigs(op, 1, 20);
-  eigs.init();
-  eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-10);
-  if (eigs.info() != Spectra::CompInfo::Successful) {
-    throw std::runtime_error("Spectra: the largest eigenvalue of -K/m did not converge");
-  }
-  const double top = eigs.eigenvalues()[0];
-  if (!(top > 0.0)) throw std::runtime_error("Spectra: -K/m has no positive eigenvalue");
-  return std::sqrt(top);
-}
 
 namespace {
 

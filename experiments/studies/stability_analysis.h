@@ -18,6 +18,7 @@
 #include <string>
 #include <string_view>
 
+#include "solvers/modes.h"
 #include "solvers/solver_options.h"
 #include "src/integrator_name.h"
 #include "src/model.h"
@@ -25,9 +26,8 @@
 
 namespace jello::experiments {
 
-// sqrt of the largest eigenvalue of -K/m at `state` (rad/s); K is the exact (unclamped) spring
-// and contact Jacobian. Throws std::runtime_error when Spectra does not converge.
-double maxAngularFrequency(const Model& model, const State& state);
+// maxAngularFrequency (solvers/modes.h), as the experiments call it.
+using jello::maxAngularFrequency;
 
 // The largest h at which `kind` is stable on every mode up to wMax with damping ratio
 // r * w / 2 (r = c/k in s); 0 when never stable, +infinity for implicit and cvode.

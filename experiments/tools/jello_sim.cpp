@@ -19,6 +19,7 @@
 
 #include "experiments/common/progress.h"
 #include "experiments/common/signal_handler.h"
+#include "solvers/modes.h"
 #include "solvers/simulation.h"
 #include "solvers/solver_threads.h"
 #include "src/atomic_file.h"
@@ -96,6 +97,36 @@ class Trace {
   std::ostringstream csv_;
 };
 
+// CVODE keeps its error at rtol on every mode the scene excites, so a lightly damped stiff mode
+// is followed, not stepped over: its steps settle at h w_max of about kCvodeStepTimesWmax
+// (scripts/cvode-stiff.py measured 0.07-0.16 on jello.w at k = 1e4 .. 1e7, lowest at the
+// stiffest; experiments/results/cvode_stiff.csv). A run that would need more than
+// kCvodeStepsWorthAWarning internal steps says so before it starts.
+constexpr double kCvodeStepTimesWmax = 0.07;
+constexpr double kCvodeStepsWorthAWarning = 2e5;
+
+void warnOfLightlyDampedStiffness(const Simulation& sim, double simulated, double kElastic,
+                                  double dElastic) {
+  const Energy e = sim.model().energy(sim.state());
+  if (!(e.kinetic + e.spring > 0.0)) return;  // at rest: nothing to follow
+  double wMax = 0.0;
+  try {
+    wMax = jello::maxAngularFrequency(sim.model(), sim.state());
+  } catch (const std::exception&) {
+    return;  // no estimate, no warning
+  }
+  const double zeta = kElastic > 0.0 ? dElastic * wMax / (2.0 * kElastic) : 1.0;
+  const double steps = simulated * wMax / kCvodeStepTimesWmax;
+  if (zeta >= 1.0 || !(steps > kCvodeStepsWorthAWarning)) return;
+  std::fprintf(stderr,
+               "jello-sim: warning: cvode follows this scene's fastest mode (w_max = %.3g rad/s, "
+               "damping ratio %.2g) at its tolerance: if the start excites it, expect about %.2g "
+               "internal steps for %g "
+               "simulated s (h w_max ~ %g, measured). implicit or projective at --dt 0.001 step "
+               "over it, at the price of damping it (README, \"cvode on very stiff scenes\")\n",
+               wMax, zeta, steps, simulated, kCvodeStepTimesWmax);
+}
+
 int run(const Options& opt) {
   // Every output is checked before the run: a bad --stats path must not be found after an
   // hour. Two outputs to one file would overwrite each other.
@@ -151,6 +182,7 @@ int run(const Options& opt) {
       return kExitUsage;
     }
   }
+  const double kElastic = world.kElastic, dElastic = world.dElastic;
   Simulation sim(std::move(world), kind, opt.dt, opt.solver);
   const double dt = sim.dt();
   const double wanted =
@@ -170,6 +202,10 @@ int run(const Options& opt) {
                    "%ld steps, to t = %.9g s (%.3g s past)\n",
                    *opt.time, dt, total, end, end - asked);
     }
+  }
+  if (sim.integratorKind() == jello::IntegratorKind::Cvode && !opt.quiet) {
+    warnOfLightlyDampedStiffness(sim, opt.steps ? double(total) * dt : opt.time.value_or(1.0),
+                                 kElastic, dElastic);
   }
   const Energy start = sim.model().energy(sim.state());
   const jello::Vec3 startL = sim.model().angularMomentum(sim.state());
