@@ -253,11 +253,16 @@ StepResult CvodeIntegrator::step(const Model& model, State& s, double h) {
   const double tout = s.t + h;
   sunrealtype reached = s.t;
   sundialsMessage_.clear();
+  resourceFailure_.clear();
   for (;;) {
     const int flag = CVode(cvode_.get(), tout, y_.get(), &reached, CV_NORMAL);
     if (flag < 0 && interruptRequested()) {
       restartPending_ = true;  // CVODE's state is mid-step: start afresh if stepped again
       return StepResult::interruption();  // s is still the output interval's start
+    }
+    if (flag < 0 && !resourceFailure_.empty()) {
+      restartPending_ = true;
+      return StepResult::resourceFailure(resourceFailure_);
     }
     if (flag < 0) {
       std::string why = cvodeError("CVode", flag);
@@ -309,14 +314,14 @@ int CvodeIntegrator::linearSystem(const double* y, bool jacobianOk, bool* jacobi
 }
 
 int CvodeIntegrator::setupSolver() {
-  return system_.factorize().ok ? 0 : 1;
+  return linearSolverFlag(system_.factorize());
 }
 
 int CvodeIntegrator::solve(const double* b, double* x) {
   const Eigen::Map<const Eigen::VectorXd> r1(b, n3_), r2(b + n3_, n3_);
   rhs_.noalias() = system_.K() * r1;
   rhs_ = model_->mass() * r2 + gamma_ * rhs_;
-  if (!system_.solve(rhs_, b_).ok) return 1;
+  if (const int flag = linearSolverFlag(system_.solve(rhs_, b_)); flag != 0) return flag;
   Eigen::Map<Eigen::VectorXd>(x + n3_, n3_) = b_;
   Eigen::Map<Eigen::VectorXd>(x, n3_) = r1 + gamma_ * b_;
   return 0;

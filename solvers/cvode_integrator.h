@@ -82,6 +82,15 @@ class CvodeIntegrator final : public Integrator {
   bool preconditionerReady_ = false;  // krylov: a factor from an earlier setup is there
   std::array<long, kNumCounters> carried_{};
   std::string sundialsMessage_;  // SUNDIALS' last error message, for ours
+  // A linear solver that could not run here (StepResult::resource): the callback returns an
+  // unrecoverable -1 and step() reports this instead of CVODE's failure.
+  std::string resourceFailure_;
+  int linearSolverFlag(const StepResult& r) {
+    if (r.ok) return 0;
+    if (!r.resource) return 1;  // recoverable: CVODE retries with a smaller step
+    resourceFailure_ = r.message;
+    return -1;
+  }
   bool restartPending_ = false;  // the model's forces changed from outside
 };
 
