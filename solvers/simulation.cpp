@@ -40,15 +40,20 @@ std::optional<std::string> findDivergence(const State& s, double bound, double s
 }
 
 double Simulation::energyBudget() const {
-  return kEnergyGrowthFactor * energyStart_ + kEnergyFloor;
+  return kEnergyGrowthFactor * energyEnvelope_ + kEnergyFloor;
 }
 
 std::optional<std::string> Simulation::energyGrowth() {
   const double now = model_.energy(state_).total() - externalWork();
+  if (steps_ - envelopeStart_ <= kEnergyEnvelopeSteps) {
+    energyEnvelope_ = std::max(energyEnvelope_, now);
+    return std::nullopt;
+  }
   if (now <= energyBudget()) return std::nullopt;
   std::ostringstream os;
   os << "the energy grew to " << now << " J (energy bound " << kEnergyGrowthFactor
-     << " x its start " << energyStart_ << " J + " << kEnergyFloor
+     << " x its envelope " << energyEnvelope_ << " J, the largest of its first "
+     << kEnergyEnvelopeSteps << " steps, + " << kEnergyFloor
      << " J, net of the field's and the user force's work)";
   return os.str();
 }
@@ -68,7 +73,7 @@ Simulation::Simulation(World world, std::optional<IntegratorKind> integrator,
       options_(options),
       integrator_(makeIntegrator(integrator.value_or(world_.integrator), options_)),
       dt_(dt.value_or(world_.dt)),
-      energyStart_(std::max(0.0, model_.energy(state_).total())) {}
+      energyEnvelope_(std::max(0.0, model_.energy(state_).total())) {}
 
 StepResult Simulation::step() {
   if (divergence_) return StepResult::failure(divergence_->describe());
@@ -104,7 +109,9 @@ StepResult Simulation::step() {
     // The work of the forces no potential describes, only for scenes that have them.
     if (model_.hasField()) fieldWork_ += model_.fieldWork(previous_.x.data(), state_.x.data());
     if (model_.hasUserForce()) userWork_ += model_.userForceWork(previous_.x, state_.x);
-    if (steps_ % kEnergyCheckInterval == 0) broken = energyGrowth();
+    if (steps_ - envelopeStart_ <= kEnergyEnvelopeSteps || steps_ % kEnergyCheckInterval == 0) {
+      broken = energyGrowth();
+    }
   }
   if (!broken) return result;
   state_ = previous_;
@@ -126,7 +133,8 @@ void Simulation::stateEdited() {
                "an edited state keeps its size");
   integrator_->restart();
   if (divergence_ && !findDivergence(state_)) divergence_.reset();
-  energyStart_ = std::max(0.0, model_.energy(state_).total() - externalWork());
+  energyEnvelope_ = std::max(0.0, model_.energy(state_).total() - externalWork());
+  envelopeStart_ = steps_;
 }
 
 void Simulation::setTimeStep(double dt) {

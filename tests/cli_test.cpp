@@ -212,7 +212,8 @@ TEST(JelloSim, AnAddressSpaceLimitTooTightForTheBlasIsReportedNotAHang) {
 #else
   test::TempDir dir;
   for (const char* how :
-       {"--integrator implicit --linear-solver cholmod", "--integrator projective"}) {
+       {"--integrator implicit --linear-solver cholmod", "--integrator projective",
+        "--integrator cvode --linear-solver cholmod"}) {
     const auto out = dir.path() / "out.w";
     const auto start = std::chrono::steady_clock::now();
     const Outcome r =

@@ -1,6 +1,8 @@
 // The experiments: the stability analysis against closed forms, the tested definition of
 // "blew up", and --quick runs of each program whose CSV must hold the physics the README
 // states (thresholds near their predictions, flat Courant numbers, convergence orders).
+#include <Spectra/MatOp/SparseSymMatProd.h>
+#include <Spectra/SymEigsSolver.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,6 +13,7 @@
 #include <sstream>
 
 #include "experiments/studies/stability_analysis.h"
+#include "solvers/jacobian.h"
 #include "solvers/simulation.h"
 #include "src/scene_builder.h"
 #include "tests/test_support.h"
@@ -62,6 +65,64 @@ TEST(StabilityAnalysis, BlewUpMeansDivergedOrTenfoldEnergyWithinTheRunTime) {
   EXPECT_TRUE(diverged.blewUp);
   EXPECT_NE(diverged.reason.find("diverged"), std::string::npos) << diverged.reason;
   EXPECT_GE(diverged.steps, above.steps);
+}
+
+// The blow-up rule cannot fire on a bounded oscillation: symplectic Euler just below its limit
+// (h w_max = 1.9) swings the energy of the fastest mode by up to 1/(1 - h w/2) = 20x its start
+// (a start-referenced rule fires there) and stays bounded for 10 s; at h w_max = 2.1 the mode
+// grows and the rule fires. The cube at rest at k = 10 (damping ratio 1e-5 s), displaced along
+// its fastest mode (Spectra's top eigenvector of -K/m) by 10^-4 m: linear, so w_max at the start
+// is w_max all along. (The free scene's corner, pulled a whole spacing, is not: there symplectic
+// Euler at h w_max = 1.9 really blows up, a point 122 m out by step 49.)
+TEST(StabilityAnalysis, TheBlowUpRuleIgnoresABoundedSwingAndCatchesGrowth) {
+  SceneSpec spec = stiffCube(10.0);
+  spec.dElastic = 1e-5 * 10.0;
+  spec.pose = PosePreset::Rest;
+  World w = buildWorld(spec);
+  const Model model(w);
+  JacobianAssembler jacobian(model);
+  jacobian.assemble(initialState(w).x.data(), {.clampCompression = false});
+  const SparseMatrix a = -jacobian.K() / model.mass();
+  Spectra::SparseSymMatProd<double> op(a);
+  Spectra::SymEigsSolver<Spectra::SparseSymMatProd<double>> eigs(op, 1, 20);
+  eigs.init();
+  eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-10);
+  ASSERT_EQ(eigs.info(), Spectra::CompInfo::Successful);
+  const Eigen::VectorXd mode = eigs.eigenvectors().col(0);
+  const double wMax = std::sqrt(eigs.eigenvalues()[0]);
+  const int n = model.numPoints();
+  const double scale = 1e-4 / mode.cwiseAbs().maxCoeff();
+  for (int p = 0; p < n; ++p) {
+    w.positions[p] += Vec3{scale * mode[p], scale * mode[n + p], scale * mode[2 * n + p]};
+  }
+  const BlowUpRule rule{10.0, 10.0, 0};
+  // The swing: the largest energy over the first steps against the start's.
+  Simulation sim(w, IntegratorKind::Symplectic, 1.9 / wMax);
+  const double e0 = sim.model().energy(sim.state()).total();
+  double largest = e0;
+  for (int i = 0; i < 400; ++i) {
+    ASSERT_TRUE(sim.step().ok);
+    largest = std::max(largest, sim.model().energy(sim.state()).total());
+  }
+  EXPECT_GT(largest, 10.0 * e0) << "the swing a start-referenced rule fires on";
+  const Trial below = runTrial(w, IntegratorKind::Symplectic, 1.9 / wMax, rule);
+  EXPECT_FALSE(below.blewUp) << below.reason;
+  EXPECT_EQ(below.steps, std::lround(10.0 / (1.9 / wMax)));
+  const Trial above = runTrial(w, IntegratorKind::Symplectic, 2.1 / wMax, rule);
+  EXPECT_TRUE(above.blewUp);
+  EXPECT_LT(above.steps, 1000);
+}
+
+// Explicit methods run at least minSteps steps: RK4 at k = 10 just past its limit (h w_max 1.05
+// times 2 sqrt 2) grows too slowly for a 0.2 s window (20 steps) and is caught within 2000.
+TEST(StabilityAnalysis, ExplicitTrialsRunLongEnoughToSeeSlowGrowth) {
+  const World w = stabilityScene("free", 10.0, 1e-5);
+  const double wMax = maxAngularFrequency(Model(w), initialState(w));
+  const double dt = 1.05 * predictedThreshold(IntegratorKind::RK4, wMax, 1e-5);
+  EXPECT_FALSE(runTrial(w, IntegratorKind::RK4, dt, {0.2, 10.0, 1}).blewUp);
+  const Trial trial = runTrial(w, IntegratorKind::RK4, dt, {0.2, 10.0, 2000});
+  EXPECT_TRUE(trial.blewUp);
+  EXPECT_GT(trial.steps, std::lround(0.2 / dt));
 }
 
 // Share of the bottom layer's samples (every step, every bottom point) above the floor.

@@ -73,8 +73,13 @@ int main(int argc, char** argv) {
   app.add_option("--time", opt.rule.time, "Simulated time a stable run must survive, s")
       ->check(jello::cli::positive())
       ->capture_default_str();
+  app.add_option("--min-steps", opt.rule.minSteps,
+                 "Explicit methods run at least this many steps (slow growth shows)")
+      ->check(CLI::Range(1L, 100000000L))
+      ->capture_default_str();
   app.add_option("--energy-factor", opt.rule.energyFactor,
-                 "Blow-up when the total energy exceeds this times its start")
+                 "Blow-up when the total energy exceeds this times its envelope (the largest "
+                 "energy of the first 64 steps)")
       ->check(jello::cli::range(1.0, 1e12))
       ->capture_default_str();
   app.add_option("--tolerance", opt.tolerance, "Bisection stops at unstable/stable <= 1 + this")
@@ -118,6 +123,7 @@ int main(int argc, char** argv) {
     if (app.count("--k") == 0) opt.ks = {1e2, 1e4};
     if (app.count("--scenes") == 0) opt.scenes = {"free"};
     if (app.count("--time") == 0) opt.rule.time = 0.1;
+    if (app.count("--min-steps") == 0) opt.rule.minSteps = 500;
     if (app.count("--tolerance") == 0) opt.tolerance = 0.05;
   }
   if (opt.ks.empty()) {
@@ -186,7 +192,9 @@ int main(int argc, char** argv) {
                            {"wall_contact_ratio", opt.contactRatio},
                            {"blow_up",
                             {{"time_s", opt.rule.time},
+                             {"explicit_min_steps", opt.rule.minSteps},
                              {"energy_factor", opt.rule.energyFactor},
+                             {"energy_envelope_steps", kEnergyEnvelopeSteps},
                              {"divergence_bound_m", kDivergenceBound}}},
                            {"bisection_tolerance", opt.tolerance},
                            {"dt_max_s", opt.dtMax},
