@@ -20,9 +20,10 @@ os.environ.setdefault("OMP_THREAD_LIMIT", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import jello  # noqa: E402
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from readme_blocks import write_blocks  # noqa: E402
+
 CSV = os.path.join(ROOT, "experiments", "results", "cvode_stiff.csv")
-README = os.path.join(ROOT, "README.md")
-BEGIN, END = "<!-- cvode-stiff:begin -->", "<!-- cvode-stiff:end -->"
 KS = [1e4, 1e5, 1e6, 1e7]
 
 
@@ -59,6 +60,12 @@ def measure():
     return rows
 
 
+def committed_rows():
+    with open(CSV, newline="") as f:
+        return [{k: (v if k == "integrator" else float(v)) for k, v in r.items()}
+                for r in csv.DictReader(f)]
+
+
 def duration(s):
     if s < 120:
         return f"{s:.3g} s"
@@ -85,9 +92,7 @@ def main():
     parser.add_argument("--readme", action="store_true", help="rewrite the README table")
     args = parser.parse_args()
     if args.no_run:
-        with open(CSV, newline="") as f:
-            rows = [{k: (v if k == "integrator" else float(v)) for k, v in r.items()}
-                    for r in csv.DictReader(f)]
+        rows = committed_rows()
     else:
         rows = measure()
         tmp = CSV + ".tmp"
@@ -100,15 +105,7 @@ def main():
     print(f"cvode h w_max from {min(hw):.3g} to {max(hw):.3g}")
     print(table(rows))
     if args.readme:
-        with open(README) as f:
-            text = f.read()
-        if BEGIN not in text or END not in text:
-            sys.exit(f"README.md has no {BEGIN} ... {END} markers")
-        head, rest = text.split(BEGIN, 1)
-        _, tail = rest.split(END, 1)
-        with open(README + ".tmp", "w") as f:
-            f.write(head + BEGIN + "\n" + table(rows) + "\n" + END + tail)
-        os.replace(README + ".tmp", README)
+        write_blocks({"cvode-stiff": table(rows)})
     return 0
 
 

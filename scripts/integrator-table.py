@@ -33,21 +33,18 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from readme_blocks import write_blocks  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 WORLD = os.path.join(ROOT, "worlds", "spinning-k1e4.w")
 CSV = os.path.join(ROOT, "experiments", "results", "integrators.csv")
 SIDECAR = os.path.join(ROOT, "experiments", "results", "integrators.json")
-README = os.path.join(ROOT, "README.md")
-BEGIN, END = "<!-- integrators-table:begin -->", "<!-- integrators-table:end -->"
 # Google Benchmark's JSON of BM_ImplicitIntegratorStep (see --steps-json), and its README table.
 STEPS_JSON = os.path.join(ROOT, "experiments", "results", "implicit_steps.json")
-STEPS_BEGIN, STEPS_END = "<!-- implicit-steps:begin -->", "<!-- implicit-steps:end -->"
 CROSSOVER_JSON = os.path.join(ROOT, "experiments", "results", "crossover.json")
-CROSSOVER_BEGIN, CROSSOVER_END = "<!-- crossover:begin -->", "<!-- crossover:end -->"
-CVODE_BEGIN, CVODE_END = "<!-- cvode-second:begin -->", "<!-- cvode-second:end -->"
 # BM_KeptFactorSolve (solvers/prefactored_cholesky.h), its own JSON.
 FACTOR_JSON = os.path.join(ROOT, "experiments", "results", "kept_factor.json")
-FACTOR_BEGIN, FACTOR_END = "<!-- kept-factor:begin -->", "<!-- kept-factor:end -->"
 
 # Benchmark variants of one integrator (experiments/bench/benchmarks_implicit.cpp), as the tables
 # name them.
@@ -262,14 +259,6 @@ def duration_fine(ms):
     return f"{ms * 1e3:.3g} us" if ms < 1 else duration(ms)
 
 
-def replace_between(text, begin, end, body):
-    if begin not in text or end not in text:
-        sys.exit(f"integrator-table: README.md has no {begin} marker")
-    head, rest = text.split(begin, 1)
-    _, tail = rest.split(end, 1)
-    return head + begin + "\n" + body + "\n" + end + tail
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--bin", default=os.path.join(ROOT, "build", "release", "bin"))
@@ -305,14 +294,11 @@ def main():
                    "date_utc": datetime.datetime.utcnow().strftime("%Y-%m-%dT%H:%M:%SZ")}
         write_atomically(SIDECAR, json.dumps(sidecar, indent=2) + "\n")
     if args.readme:
-        with open(README) as f:
-            text = f.read()
-        text = replace_between(text, BEGIN, END, table_from_csv())
-        text = replace_between(text, STEPS_BEGIN, STEPS_END, steps_table_from_json())
-        text = replace_between(text, CROSSOVER_BEGIN, CROSSOVER_END, crossover_table_from_json())
-        text = replace_between(text, CVODE_BEGIN, CVODE_END, cvode_table_from_json())
-        text = replace_between(text, FACTOR_BEGIN, FACTOR_END, kept_factor_table_from_json())
-        write_atomically(README, text)
+        write_blocks({"integrators-table": table_from_csv(),
+                      "implicit-steps": steps_table_from_json(),
+                      "crossover": crossover_table_from_json(),
+                      "cvode-second": cvode_table_from_json(),
+                      "kept-factor": kept_factor_table_from_json()})
 
 
 if __name__ == "__main__":

@@ -17,6 +17,14 @@ if [ "${1:-}" = quick ]; then
   stability_scenes=free
   precision_scenes=soft
 fi
+# Committed results come from a clean tree: each sidecar records its commit, which must be the
+# code that ran. JELLO_ALLOW_DIRTY=1 runs anyway (the sidecars then say "tree_modified": true).
+if [ "$out" = experiments/results ] && [ -z "${JELLO_ALLOW_DIRTY:-}" ] &&
+   [ -n "$(git status --porcelain --untracked-files=no)" ]; then
+  echo "run-experiments: the tree has uncommitted changes; commit them first (the results would" >&2
+  echo "  name a commit that is not the code that ran), or set JELLO_ALLOW_DIRTY=1" >&2
+  exit 1
+fi
 mkdir -p "$out"
 "$bin/jello-stability" "${args[@]}" --out-dir "$out"
 "$bin/jello-work-precision" "${args[@]}" --out-dir "$out"

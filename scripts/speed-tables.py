@@ -18,11 +18,13 @@ import os
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from readme_blocks import write_blocks  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 JSON = os.path.join(ROOT, "experiments", "results", "speed.json")
 # Both cores: BM_Threads, run without taskset (1 and 2 threads in the same run).
 THREADS_JSON = os.path.join(ROOT, "experiments", "results", "speed_threads.json")
-README = os.path.join(ROOT, "README.md")
 BINARY = os.path.join(ROOT, "build", "release", "bin", "benchmarks")
 FILTER = ("BM_SpringForces|BM_Step/|BM_Refill|BM_Factorize|BM_Solve/|BM_CgSolve|BM_SystemProduct|"
           "BM_ImplicitStep/|BM_StiffOneSecond")
@@ -202,19 +204,7 @@ def main():
         for name, text in tables.items():
             print(f"== {name}\n{text}\n")
         return 0
-    with open(README) as f:
-        text = f.read()
-    for name, table in tables.items():
-        begin, end = f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
-        if begin not in text or end not in text:
-            sys.exit(f"README.md has no {begin} ... {end} markers")
-        head, rest = text.split(begin, 1)
-        _, tail = rest.split(end, 1)
-        text = head + begin + "\n" + table + "\n" + end + tail
-    tmp = README + ".tmp"
-    with open(tmp, "w") as f:
-        f.write(text)
-    os.replace(tmp, README)
+    write_blocks(tables)
     return 0
 
 

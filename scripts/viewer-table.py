@@ -6,6 +6,9 @@ import json
 import os
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from readme_blocks import write_blocks  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LABELS = {
     "jello-rk4-shaded": "jello.w, rk4, shaded",
@@ -37,17 +40,7 @@ def main():
     if "--readme" not in sys.argv[1:]:
         print(text)
         return
-    path = os.path.join(ROOT, "README.md")
-    readme = open(path).read()
-    begin, end = "<!-- viewer-speed:begin -->", "<!-- viewer-speed:end -->"
-    if begin not in readme or end not in readme:
-        sys.exit(f"README.md has no {begin} ... {end} markers")
-    head, rest = readme.split(begin, 1)
-    _, tail = rest.split(end, 1)
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        f.write(head + begin + "\n" + text + "\n" + end + tail)
-    os.replace(tmp, path)
+    write_blocks({"viewer-speed": text})
 
 
 if __name__ == "__main__":

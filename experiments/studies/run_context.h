@@ -13,6 +13,8 @@
 
 namespace jello::experiments {
 
+// Command line, commit and whether the tracked tree is modified, compiler, BLAS, machine, date:
+// taken as the run starts, so that the outputs the run writes do not mark its own tree modified.
 nlohmann::json runContext(int argc, char** argv);
 void writeSidecar(const std::filesystem::path& path, const nlohmann::json& sidecar);
 

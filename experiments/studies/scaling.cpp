@@ -86,6 +86,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  // The tree as the run starts: the code that ran (outputs written later do not count).
+  const nlohmann::json context = runContext(argc, argv);
   // The output directory is made and checked before the (long) run.
   if (!prepareOutputDirectory("jello-scaling", outDir, name)) return 1;
   if (quick) {
@@ -158,7 +160,7 @@ int main(int argc, char** argv) {
     std::cerr << "jello-scaling: error: " << e.what() << '\n';
     return 1;
   }
-  nlohmann::json sidecar = runContext(argc, argv);
+  nlohmann::json sidecar = context;
   sidecar["program"] = "jello-scaling";
   sidecar["parameters"] = {
       {"n", ns},

@@ -106,6 +106,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  // The tree as the run starts: the code that ran (outputs written later do not count).
+  const nlohmann::json context = runContext(argc, argv);
   // The output directory is made and checked before the (long) run.
   if (!prepareOutputDirectory("jello-stability", opt.outDir, opt.name)) return 1;
   std::vector<IntegratorKind> kinds;
@@ -184,7 +186,7 @@ int main(int argc, char** argv) {
     return 1;
   }
 
-  nlohmann::json sidecar = runContext(argc, argv);
+  nlohmann::json sidecar = context;
   sidecar["program"] = "jello-stability";
   sidecar["parameters"] = {{"k_N_per_m", opt.ks},
                            {"scenes", opt.scenes},

@@ -120,6 +120,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  // The tree as the run starts: the code that ran (outputs written later do not count).
+  const nlohmann::json context = runContext(argc, argv);
   // The output directory is made and checked before the (long) run.
   if (!prepareOutputDirectory("jello-work-precision", outDir, name)) return 1;
   if (quick && app.count("--levels") == 0) levels = 3;
@@ -231,7 +233,7 @@ int main(int argc, char** argv) {
     return 1;
   }
 
-  nlohmann::json sidecar = runContext(argc, argv);
+  nlohmann::json sidecar = context;
   sidecar["program"] = "jello-work-precision";
   nlohmann::json sceneInfo = nlohmann::json::array();
   for (const Scene& s : scenes) {
