@@ -111,6 +111,12 @@ TEST(StabilityAnalysis, TheBlowUpRuleIgnoresABoundedSwingAndCatchesGrowth) {
   const Trial above = runTrial(w, IntegratorKind::Symplectic, 2.1 / wMax, rule);
   EXPECT_TRUE(above.blewUp);
   EXPECT_LT(above.steps, 1000);
+  // The free scene, nonlinear, at the same h w_max: a real blow-up, by position.
+  const World pulled = stabilityScene("free", 10.0, 1e-5);
+  const double wPulled = maxAngularFrequency(Model(pulled), initialState(pulled));
+  const Trial real = runTrial(pulled, IntegratorKind::Symplectic, 1.9 / wPulled, rule);
+  EXPECT_TRUE(real.blewUp);
+  EXPECT_NE(real.reason.find("position bound"), std::string::npos) << real.reason;
 }
 
 // Explicit methods run at least minSteps steps: RK4 at k = 10 just past its limit (h w_max 1.05
