@@ -1,5 +1,6 @@
 # Stability map from stability.csv: largest stable dt against k (measured points, predicted
-# lines), and the same thresholds in Courant numbers h*w_max.
+# lines), and the same thresholds in Courant numbers h*w_max. One definition of the Courant
+# number throughout: h w_max, w_max the scene's fastest mode (the dashed lines are h w_max = 1).
 # gnuplot -e "dir='experiments/results'" experiments/plots/stability.gp
 if (!exists("dir")) dir = 'experiments/results'
 if (!exists("scenes")) scenes = 'free wall'  # the scenes the CSV holds (--quick: free)
@@ -11,7 +12,6 @@ set grid
 set key below maxrows 3
 set xlabel 'spring stiffness k (N/m)'
 sel(scene, integ, src) = sprintf("< awk -F, '$1==\"%s\" && $2==\"%s\" && $7==\"%s\"' %s", scene, integ, src, csv)
-m = 1.0/512
 integrators = "euler symplectic rk4 implicit cvode"
 colors = "#d62728 #2ca02c #1f77b4 #9467bd #ff7f0e"
 
@@ -26,7 +26,7 @@ do for [scene in scenes] {
          for [i=1:3] sel(scene, word(integrators,i), 'measured') using 3:8 with points pt 7 ps 1.1 lc rgb word(colors,i) title word(integrators,i).' measured', \
          sel(scene, 'implicit', 'measured') using 3:8 with points pt 4 ps 2.2 lw 2 lc rgb word(colors,4) title 'implicit: stable at the largest dt tried', \
          sel(scene, 'cvode', 'measured') using 3:8 with points pt 7 ps 0.9 lc rgb word(colors,5) title 'cvode: stable at the largest dt tried', \
-         sqrt(m/x) with lines dt 2 lc rgb 'black' title 'Courant dt = sqrt(m/k)'
+         sel(scene, 'rk4', 'measured') using 3:(1/$5) with lines dt 2 lc rgb 'black' title 'Courant number 1: dt = 1/w_{max} (w_{max} of the scene, from the CSV)'
     set output
   }
   do for [fmt in "pngcairo svg"] {
@@ -36,7 +36,8 @@ do for [scene in scenes] {
     set ylabel 'h w_{max}'
     set yrange [0.005:10]
     plot for [i=1:3] sel(scene, word(integrators,i), 'predicted') using 3:9 with lines lw 2 lc rgb word(colors,i) title word(integrators,i).' predicted', \
-         for [i=1:3] sel(scene, word(integrators,i), 'measured') using 3:9 with points pt 7 ps 1.1 lc rgb word(colors,i) title word(integrators,i).' measured'
+         for [i=1:3] sel(scene, word(integrators,i), 'measured') using 3:9 with points pt 7 ps 1.1 lc rgb word(colors,i) title word(integrators,i).' measured', \
+         1 with lines dt 2 lc rgb 'black' title 'Courant number 1: dt = 1/w_{max}'
     set output
   }
 }
