@@ -27,4 +27,21 @@ double maxAngularFrequency(const Model& model, const State& state) {
   return std::sqrt(top);
 }
 
+std::optional<CvodeCostEstimate> cvodeCostWarning(const Model& model, const State& state,
+                                                  double simulated, double kElastic,
+                                                  double dElastic) {
+  const Energy e = model.energy(state);
+  if (!(e.kinetic + e.spring > 0.0)) return std::nullopt;  // at rest: nothing to follow
+  CvodeCostEstimate c;
+  try {
+    c.wMax = maxAngularFrequency(model, state);
+  } catch (const std::exception&) {
+    return std::nullopt;  // no estimate, no warning
+  }
+  c.dampingRatio = kElastic > 0.0 ? dElastic * c.wMax / (2.0 * kElastic) : 1.0;
+  c.steps = simulated * c.wMax / kCvodeStepTimesWmax;
+  if (c.dampingRatio >= 1.0 || !(c.steps > kCvodeStepsWorthAWarning)) return std::nullopt;
+  return c;
+}
+
 }  // namespace jello

@@ -4,6 +4,8 @@
 // modes at 0. Used by the stability analysis (experiments/studies) and jello-sim's cvode warning.
 #pragma once
 
+#include <optional>
+
 #include "src/model.h"
 #include "src/state.h"
 
@@ -12,5 +14,23 @@ namespace jello {
 // sqrt of the largest eigenvalue of -K/m at `state` (rad/s); K is the exact (unclamped) spring
 // and contact Jacobian. Throws std::runtime_error when Spectra does not converge.
 double maxAngularFrequency(const Model& model, const State& state);
+
+// CVODE keeps its error at rtol on every mode the scene excites, so a lightly damped stiff mode
+// is followed, not stepped over: its steps settle at h w_max of about kCvodeStepTimesWmax
+// (scripts/cvode-stiff.py measured 0.07-0.16 on jello.w at k = 1e4 .. 1e7, lowest at the
+// stiffest; experiments/results/cvode_stiff.csv).
+inline constexpr double kCvodeStepTimesWmax = 0.07;
+inline constexpr double kCvodeStepsWorthAWarning = 2e5;
+struct CvodeCostEstimate {
+  double wMax = 0.0;          // rad/s
+  double dampingRatio = 0.0;  // of the fastest mode, d w_max / 2k
+  double steps = 0.0;         // internal steps for the simulated time
+};
+// The estimate for `simulated` seconds from `state` when it exceeds kCvodeStepsWorthAWarning
+// steps with the fastest mode underdamped and the start not at rest; nothing otherwise (or when
+// w_max cannot be computed).
+std::optional<CvodeCostEstimate> cvodeCostWarning(const Model& model, const State& state,
+                                                  double simulated, double kElastic,
+                                                  double dElastic);
 
 }  // namespace jello

@@ -97,34 +97,17 @@ class Trace {
   std::ostringstream csv_;
 };
 
-// CVODE keeps its error at rtol on every mode the scene excites, so a lightly damped stiff mode
-// is followed, not stepped over: its steps settle at h w_max of about kCvodeStepTimesWmax
-// (scripts/cvode-stiff.py measured 0.07-0.16 on jello.w at k = 1e4 .. 1e7, lowest at the
-// stiffest; experiments/results/cvode_stiff.csv). A run that would need more than
-// kCvodeStepsWorthAWarning internal steps says so before it starts.
-constexpr double kCvodeStepTimesWmax = 0.07;
-constexpr double kCvodeStepsWorthAWarning = 2e5;
-
 void warnOfLightlyDampedStiffness(const Simulation& sim, double simulated, double kElastic,
                                   double dElastic) {
-  const Energy e = sim.model().energy(sim.state());
-  if (!(e.kinetic + e.spring > 0.0)) return;  // at rest: nothing to follow
-  double wMax = 0.0;
-  try {
-    wMax = jello::maxAngularFrequency(sim.model(), sim.state());
-  } catch (const std::exception&) {
-    return;  // no estimate, no warning
-  }
-  const double zeta = kElastic > 0.0 ? dElastic * wMax / (2.0 * kElastic) : 1.0;
-  const double steps = simulated * wMax / kCvodeStepTimesWmax;
-  if (zeta >= 1.0 || !(steps > kCvodeStepsWorthAWarning)) return;
+  const auto w = jello::cvodeCostWarning(sim.model(), sim.state(), simulated, kElastic, dElastic);
+  if (!w) return;
   std::fprintf(stderr,
                "jello-sim: warning: cvode follows this scene's fastest mode (w_max = %.3g rad/s, "
                "damping ratio %.2g) at its tolerance: if the start excites it, expect about %.2g "
-               "internal steps for %g "
-               "simulated s (h w_max ~ %g, measured). implicit or projective at --dt 0.001 step "
-               "over it, at the price of damping it (README, \"cvode on very stiff scenes\")\n",
-               wMax, zeta, steps, simulated, kCvodeStepTimesWmax);
+               "internal steps for %g simulated s (h w_max ~ %g, measured). implicit or "
+               "projective at --dt 0.001 step over it, at the price of damping it (README, "
+               "\"cvode on very stiff scenes\")\n",
+               w->wMax, w->dampingRatio, w->steps, simulated, jello::kCvodeStepTimesWmax);
 }
 
 int run(const Options& opt) {
