@@ -354,9 +354,7 @@ World readWorld(const std::filesystem::path& path, const ReaderLimits& limits) {
     size = fs::file_size(path, ec);
     if (ec) size = 0;
     if (size > limits.maxFileBytes) {
-      throw WorldFileError(name, 0, name,
-                           "file is larger than the reader allows (" +
-                               std::to_string(limits.maxFileBytes) + " bytes)");
+      throw reader::fileTooLarge(name, limits.maxFileBytes);
     }
   }
   std::ifstream file(path, std::ios::binary);

@@ -17,6 +17,13 @@
 
 namespace jello::reader {
 
+// A file past the reader's size limit, found before reading (its size) or while reading (a pipe).
+inline WorldFileError fileTooLarge(const std::string& name, std::uintmax_t maxBytes) {
+  return WorldFileError(
+      name, 0, name,
+      "file is larger than the reader allows (" + std::to_string(maxBytes) + " bytes)");
+}
+
 constexpr std::string_view kEndOfFile = "<end of file>";
 
 // A token as the reader keeps it: its first kMaxTokenBytes bytes (a longer one cannot be a
@@ -178,9 +185,7 @@ class Tokenizer {
     end_ += got;
     consumed_ += got;
     if (consumed_ > max_) {
-      throw WorldFileError(
-          name_, 0, name_,
-          "file is larger than the reader allows (" + std::to_string(max_) + " bytes)");
+      throw fileTooLarge(name_, max_);
     }
     return true;
   }
