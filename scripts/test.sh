@@ -3,9 +3,11 @@
 # `scripts/test.sh asan` does the same with AddressSanitizer and UndefinedBehaviorSanitizer
 # (assertions and validations on), leaving out the tests labelled slow, soak and experiments
 # (minutes of simulation, 5-10x slower sanitized). JELLO_WERROR=ON makes warnings errors.
+# Arguments after the preset go to ctest (CI: `scripts/test.sh release --label-exclude soak`).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset=${1:-release}
+shift || true
 scripts/install-deps.sh
 scripts/build.sh "$preset"
 # One test per core. GNU nproc honours OMP_NUM_THREADS and OMP_THREAD_LIMIT, so it is asked
@@ -15,4 +17,4 @@ jobs=$(env -u OMP_NUM_THREADS -u OMP_THREAD_LIMIT nproc)
 export OMP_THREAD_LIMIT=${OMP_THREAD_LIMIT:-1} OPENBLAS_NUM_THREADS=${OPENBLAS_NUM_THREADS:-1}
 exclude=()
 [ "$preset" = asan ] && exclude=(--label-exclude "slow|soak|experiments")
-ctest --preset "$preset" -j"$jobs" "${exclude[@]}"
+ctest --preset "$preset" -j"$jobs" "${exclude[@]}" "$@"
