@@ -184,6 +184,24 @@ TEST(SimRunner, PanelEditsReachTheModel) {
   EXPECT_EQ(solver.state.x, before.state.x);
 }
 
+TEST(SimRunner, AfterSyncTheFrameShowsEveryCommandPosted) {
+  // sync() must wait for the frame published after the commands, not only for the commands:
+  // the runner builds that frame unlocked, and a sync() returning in between (once in a few
+  // hundred rounds) handed out the frame from before.
+  World w = test::loadWorld("jello.w");
+  SimRunner::Options o;
+  o.paused = true;
+  SimRunner runner(source("jello.w"), w, o);
+  for (int round = 1; round <= 300; ++round) {
+    const double k = w.kElastic * (1.0 + round);
+    runner.post([k](ViewerSession& s) { s.editWorld([k](World& world) { world.kElastic = k; }); });
+    // Arriving at sync() at varied moments of the runner's work on the command and its frame.
+    std::this_thread::sleep_for(std::chrono::microseconds(round * 37 % 4000));
+    runner.sync();
+    ASSERT_EQ(runner.frame().geometry->world.kElastic, k) << "round " << round;
+  }
+}
+
 TEST(SimRunner, ACommandThatFailsBecomesAnAlarmNotAStop) {
   SimRunner::Options o;
   o.paused = true;

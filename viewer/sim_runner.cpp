@@ -221,9 +221,12 @@ void SimRunner::loop() {
         }
       }
       lock.lock();
-      commandsDone_ += static_cast<long>(commands.size());
       const double before = latest_.state.t;
       publish(lock);
+      // Done only once their frame is out (publish unlocks while it builds the frame): sync()
+      // returning in between handed out the frame from before the commands.
+      commandsDone_ += static_cast<long>(commands.size());
+      reached_.notify_all();
       if (latest_.state.t != before) {  // a reload: time starts over
         rebaseLocked(now());
         target_ = frameTarget_ = latest_.state.t;
