@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread libsundials-dev
   freeglut3-dev libgl1-mesa-dev libglu1-mesa-dev xvfb xauth libstb-dev libimgui-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libspectra-dev libcli11-dev nlohmann-json3-dev gnuplot-nox
+  libspectra-dev libcli11-dev nlohmann-json3-dev gnuplot-nox libopenmpi-dev openmpi-bin
   clang-14 libclang-rt-14-dev clang-format-14
   python3 python3-dev pybind11-dev python3-numpy python3-scipy python3-matplotlib python3-pytest
 )

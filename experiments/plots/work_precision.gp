@@ -1,29 +1,32 @@
-# Work-precision from work_precision.csv (error at the fixed time against wall time) and
-# backward Euler's artificial damping from work_precision_damping.csv.
+# Work-precision from work_precision.csv (errors over the whole window against wall time, the
+# median of the repeats with their spread as horizontal bars) and backward Euler's artificial
+# damping from work_precision_damping.csv.
 # gnuplot -e "dir='experiments/results'" experiments/plots/work_precision.gp
 if (!exists("dir")) dir = 'experiments/results'
-if (!exists("scenes")) scenes = 'soft stiff'  # the scenes the CSV holds (--quick: soft)
+if (!exists("scenes")) scenes = 'soft drop stiff'  # the scenes the CSV holds (--quick: soft)
 csv = dir.'/work_precision.csv'
 set datafile separator ','
+set datafile missing 'nan'
 set logscale xy
 set grid
 set key outside right top
-sel(scene, integ, order) = sprintf("< awk -F, '$1==\"%s\" && $2==\"%s\" && $3==%d' %s | sort -t, -k4,4g -k5,5g", scene, integ, order, csv)
-integrators = "euler symplectic rk4 implicit"
-colors = "#d62728 #2ca02c #1f77b4 #9467bd"
+sel(scene, integ, method) = sprintf("< awk -F, '$1==\"%s\" && $2==\"%s\" && $3==\"%s\" && $22==\"ok\"' %s | sort -t, -k4,4g -k5,5g", scene, integ, method, csv)
+integrators = "euler symplectic rk4 implicit implicit-linear midpoint newmark bdf2 projective"
+colors = "#d62728 #2ca02c #1f77b4 #9467bd #c5b0d5 #17becf #bcbd22 #e377c2 #7f7f7f"
+points = "7 7 7 5 5 9 9 11 13"
 
 do for [scene in scenes] {
   do for [q in "position energy"] {
-    col = (q eq "position") ? 8 : 9
+    col = (q eq "position") ? 13 : 15
     do for [fmt in "pngcairo svg"] {
-      if (fmt eq "pngcairo") { set terminal pngcairo size 900,560 font ",10"; set output dir.'/work_precision_'.scene.'_'.q.'.png' } \
-      else { set terminal svg size 900,560 font ",10"; set output dir.'/work_precision_'.scene.'_'.q.'.svg' }
-      set title 'Work-precision, '.scene.' scene: '.(q eq "position" ? 'max position error (m)' : 'relative energy error').' at the fixed time'
-      set xlabel 'wall time (s)'
-      set ylabel (q eq "position" ? 'max |x - x_{ref}| (m)' : '|E - E_{ref}| / E_{ref}')
-      plot for [i=1:4] sel(scene, word(integrators,i), 0) using 7:col with linespoints pt 7 lw 2 lc rgb word(colors,i) title word(integrators,i), \
-           sel(scene, 'cvode', 2) using 7:col with linespoints pt 5 lw 2 lc rgb '#ff7f0e' title 'cvode, order <= 2', \
-           sel(scene, 'cvode', 5) using 7:col with linespoints pt 9 lw 2 lc rgb '#8c564b' title 'cvode, order <= 5'
+      if (fmt eq "pngcairo") { set terminal pngcairo size 980,600 font ",10"; set output dir.'/work_precision_'.scene.'_'.q.'.png' } \
+      else { set terminal svg size 980,600 font ",10"; set output dir.'/work_precision_'.scene.'_'.q.'.svg' }
+      set title 'Work-precision, '.scene.' scene: '.(q eq "position" ? 'largest position error over the window (m)' : 'largest energy error over the window, relative to E(0)')
+      set xlabel 'wall time of the steps (s; median, bars: min to max of the repeats)'
+      set ylabel (q eq "position" ? 'max_t max_i |x_i - x_{ref}| (m)' : 'max_t |E - E_{ref}| / E_{ref}(0)')
+      plot for [i=1:9] sel(scene, word(integrators,i), 'none') using 10:col:11:12 with xerrorlines pt word(points,i)+0 lw 2 lc rgb word(colors,i) title word(integrators,i), \
+           sel(scene, 'cvode', 'bdf') using 10:col:11:12 with xerrorlines pt 5 lw 2 lc rgb '#ff7f0e' title 'cvode, BDF', \
+           sel(scene, 'cvode', 'adams') using 10:col:11:12 with xerrorlines pt 9 lw 2 lc rgb '#8c564b' title 'cvode, Adams'
       set output
     }
   }

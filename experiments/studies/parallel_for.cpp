@@ -5,15 +5,18 @@
 #include <chrono>
 #include <exception>
 #include <mutex>
+#include <numeric>
 #include <thread>
 #include <vector>
 
 #include "experiments/common/progress.h"
+#include "experiments/studies/csv_table.h"
 
 namespace jello::experiments {
 
-void parallelFor(int count, int jobs, const std::string& label, bool progress,
+void parallelFor(const std::vector<int>& tasks, int jobs, const std::string& label, bool progress,
                  const std::function<void(int)>& task) {
+  const int count = int(tasks.size());
   std::atomic<int> next{0}, done{0};
   std::exception_ptr failure;
   std::mutex failureMutex;
@@ -24,7 +27,9 @@ void parallelFor(int count, int jobs, const std::string& label, bool progress,
         if (failure) return;
       }
       try {
-        task(i);
+        const int index = tasks[static_cast<std::size_t>(i)];
+        const TaskScope scope(index);
+        task(index);
       } catch (...) {
         std::lock_guard lock(failureMutex);
         if (!failure) failure = std::current_exception();
@@ -52,6 +57,13 @@ void parallelFor(int count, int jobs, const std::string& label, bool progress,
   if (reporter.joinable()) reporter.join();
   bar.finish();
   if (failure) std::rethrow_exception(failure);
+}
+
+void parallelFor(int count, int jobs, const std::string& label, bool progress,
+                 const std::function<void(int)>& task) {
+  std::vector<int> tasks(static_cast<std::size_t>(std::max(0, count)));
+  std::iota(tasks.begin(), tasks.end(), 0);
+  parallelFor(tasks, jobs, label, progress, task);
 }
 
 }  // namespace jello::experiments

@@ -9,11 +9,10 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <thread>
 
 #include "experiments/common/signal_handler.h"
 #include "experiments/studies/csv_table.h"
-#include "experiments/studies/parallel_for.h"
+#include "experiments/studies/ranks.h"
 #include "experiments/studies/run_context.h"
 #include "experiments/studies/stability_analysis.h"
 #include "solvers/simulation.h"
@@ -44,12 +43,17 @@ double statistic(const Integrator& integrator, const std::string& name) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const Ranks ranks(argc, argv);
+  if (!ranks.error().empty()) {
+    std::cerr << "jello-scaling: error: " << ranks.error() << '\n';
+    return 1;
+  }
   jello::exitCleanlyWhenOutOfMemory("jello-scaling");
   jello::ignoreBrokenPipes("jello-scaling");
   applySolverThreadSettings(argv);
   std::vector<int> ns{8, 12, 16, 24, 32};
   double k = 1e4, budget = 3.0, implicitDt = 0.01, rtol = 1e-3;
-  int jobs = int(std::max(1u, std::thread::hardware_concurrency()));
+  int jobs = ranks.defaultJobs();
   int cvodeDirectMaxN = 16;
   bool quick = false, quiet = false;
   std::string outDir = "experiments/results", name = "scaling";
@@ -89,7 +93,7 @@ int main(int argc, char** argv) {
   // The tree as the run starts: the code that ran (outputs written later do not count).
   const nlohmann::json context = runContext(argc, argv);
   // The output directory is made and checked before the (long) run.
-  if (!prepareOutputDirectory("jello-scaling", outDir, name)) return 1;
+  if (!ranks.prepareOutput("jello-scaling", outDir, name)) return 1;
   if (quick) {
     if (app.count("--n") == 0) ns = {6, 8};
     if (app.count("--budget") == 0) budget = 0.3;
@@ -120,46 +124,45 @@ int main(int argc, char** argv) {
                   "wall_per_simulated_s", "assemble_per_simulated_s", "factor_per_simulated_s",
                   "solve_per_simulated_s", "factorizations"});
   const auto started = Clock::now();
-  try {
-    parallelFor(int(tasks.size()), jobs, "points", !quiet, [&](int i) {
-      const Task& t = tasks[static_cast<std::size_t>(i)];
-      SceneSpec spec = vibratingStiffCube(k);
-      spec.cubeResolution = t.n;
-      World w = buildWorld(spec);
-      const double wMax = maxAngularFrequency(Model(w), initialState(w));
-      const double damping = w.kElastic > 0.0 ? w.dElastic / w.kElastic : 0.0;
-      double dt = implicitDt;
-      if (t.kind != IntegratorKind::Implicit && t.kind != IntegratorKind::Cvode) {
-        dt = 0.9 * predictedThreshold(t.kind, wMax, damping);
-      }
-      SolverOptions options;
-      options.implicit.linearSolver = options.cvode.linearSolver = t.solver;
-      options.cvode.rtol = rtol;
-      Simulation sim(w, t.kind, dt, options);
-      const auto t0 = Clock::now();
-      double wall = 0.0;
-      // Whole steps until the budget is spent (at least one), at most 1 simulated second.
-      while (sim.steps() == 0 || (wall < budget && sim.state().t < 1.0)) {
-        if (StepResult r = sim.step(); !r.ok) throw std::runtime_error(r.message);
-        wall = std::chrono::duration<double>(Clock::now() - t0).count();
-      }
-      const double simulated = sim.state().t;
-      const Integrator& integ = sim.integrator();
-      const bool split = t.kind == IntegratorKind::Implicit || t.kind == IntegratorKind::Cvode;
-      const auto perSecond = [&](const char* stat) {
-        return split ? statistic(integ, stat) / simulated : std::nan("");
-      };
-      table.add({long(t.n), long(w.numPoints()), long(3 * w.numPoints()),
-                 std::string(integratorName(t.kind)),
-                 std::string(split ? linearSolverName(t.solver) : "none"), k, wMax, dt, sim.steps(),
-                 simulated, wall, wall / simulated, perSecond("assemble_time_s"),
-                 perSecond("factor_time_s"), perSecond("solve_time_s"),
-                 split ? statistic(integ, "factorizations") : std::nan("")});
-    });
-  } catch (const std::exception& e) {
-    std::cerr << "jello-scaling: error: " << e.what() << '\n';
-    return 1;
-  }
+  const bool ok = ranks.run(
+      "jello-scaling", int(tasks.size()), jobs, "points", !quiet,
+      [&](int i) {
+        const Task& t = tasks[static_cast<std::size_t>(i)];
+        SceneSpec spec = vibratingStiffCube(k);
+        spec.cubeResolution = t.n;
+        World w = buildWorld(spec);
+        const double wMax = maxAngularFrequency(Model(w), initialState(w));
+        const double damping = w.kElastic > 0.0 ? w.dElastic / w.kElastic : 0.0;
+        double dt = implicitDt;
+        if (t.kind != IntegratorKind::Implicit && t.kind != IntegratorKind::Cvode) {
+          dt = 0.9 * predictedThreshold(t.kind, wMax, damping);
+        }
+        SolverOptions options;
+        options.implicit.linearSolver = options.cvode.linearSolver = t.solver;
+        options.cvode.rtol = rtol;
+        Simulation sim(w, t.kind, dt, options);
+        const auto t0 = Clock::now();
+        double wall = 0.0;
+        // Whole steps until the budget is spent (at least one), at most 1 simulated second.
+        while (sim.steps() == 0 || (wall < budget && sim.state().t < 1.0)) {
+          if (StepResult r = sim.step(); !r.ok) throw std::runtime_error(r.message);
+          wall = std::chrono::duration<double>(Clock::now() - t0).count();
+        }
+        const double simulated = sim.state().t;
+        const Integrator& integ = sim.integrator();
+        const bool split = t.kind == IntegratorKind::Implicit || t.kind == IntegratorKind::Cvode;
+        const auto perSecond = [&](const char* stat) {
+          return split ? statistic(integ, stat) / simulated : std::nan("");
+        };
+        table.add({long(t.n), long(w.numPoints()), long(3 * w.numPoints()),
+                   std::string(integratorName(t.kind)),
+                   std::string(split ? linearSolverName(t.solver) : "none"), k, wMax, dt,
+                   sim.steps(), simulated, wall, wall / simulated, perSecond("assemble_time_s"),
+                   perSecond("factor_time_s"), perSecond("solve_time_s"),
+                   split ? statistic(integ, "factorizations") : std::nan("")});
+      },
+      {&table});
+  if (!ok) return 1;
   nlohmann::json sidecar = context;
   sidecar["program"] = "jello-scaling";
   sidecar["parameters"] = {
@@ -175,8 +178,8 @@ int main(int argc, char** argv) {
       {"quick", quick}};
   sidecar["wall_time_s"] = std::chrono::duration<double>(Clock::now() - started).count();
   const std::filesystem::path dir = outDir;
-  if (!writeResults("jello-scaling", dir, name, table, sidecar)) return 1;
-  if (!quiet) {
+  if (!ranks.writeOutput("jello-scaling", dir, name, table, sidecar)) return 1;
+  if (!quiet && ranks.root()) {
     std::printf("wrote %zu rows to %s (%.1f s)\n", table.rows(), (dir / (name + ".csv")).c_str(),
                 sidecar["wall_time_s"].get<double>());
   }

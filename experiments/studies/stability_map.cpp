@@ -7,11 +7,10 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <thread>
 
 #include "experiments/common/signal_handler.h"
 #include "experiments/studies/csv_table.h"
-#include "experiments/studies/parallel_for.h"
+#include "experiments/studies/ranks.h"
 #include "experiments/studies/run_context.h"
 #include "experiments/studies/stability_analysis.h"
 #include "solvers/simulation.h"
@@ -34,7 +33,7 @@ struct Options {
   double tolerance = 0.02;
   double dtMax = 0.05;  // s
   double rtol = 1e-3;   // cvode
-  int jobs = int(std::max(1u, std::thread::hardware_concurrency()));
+  int jobs = 1;         // set from Ranks::defaultJobs
   std::string outDir = "experiments/results";
   std::string name = "stability";
   bool quick = false, quiet = false;
@@ -50,10 +49,16 @@ struct Point {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const Ranks ranks(argc, argv);
+  if (!ranks.error().empty()) {
+    std::cerr << "jello-stability: error: " << ranks.error() << '\n';
+    return 1;
+  }
   jello::exitCleanlyWhenOutOfMemory("jello-stability");
   jello::ignoreBrokenPipes("jello-stability");
   applySolverThreadSettings(argv);
   Options opt;
+  opt.jobs = ranks.defaultJobs();
   CLI::App app{
       "jello-stability: largest stable time step per integrator and stiffness, "
       "measured against predicted"};
@@ -91,7 +96,7 @@ int main(int argc, char** argv) {
   app.add_option("--rtol", opt.rtol, "cvode's relative tolerance")
       ->check(jello::cli::positive())
       ->capture_default_str();
-  app.add_option("--jobs", opt.jobs, "Grid points run in parallel")
+  app.add_option("--jobs", opt.jobs, "Grid points run in parallel (per MPI rank)")
       ->check(jello::cli::range(1, 256))
       ->capture_default_str();
   app.add_option("--out-dir", opt.outDir, "Directory for NAME.csv and NAME.json")
@@ -109,7 +114,7 @@ int main(int argc, char** argv) {
   // The tree as the run starts: the code that ran (outputs written later do not count).
   const nlohmann::json context = runContext(argc, argv);
   // The output directory is made and checked before the (long) run.
-  if (!prepareOutputDirectory("jello-stability", opt.outDir, opt.name)) return 1;
+  if (!ranks.prepareOutput("jello-stability", opt.outDir, opt.name)) return 1;
   std::vector<IntegratorKind> kinds;
   for (const std::string& name : opt.integrators) {
     const auto kind = parseIntegratorName(name);
@@ -154,37 +159,36 @@ int main(int argc, char** argv) {
   solver.cvode.rtol = opt.rtol;
   const int tasks = int(points.size() * kinds.size());
   const auto started = std::chrono::steady_clock::now();
-  try {
-    parallelFor(tasks, opt.jobs, "grid points", !opt.quiet, [&](int i) {
-      const Point& p = points[static_cast<std::size_t>(i) / kinds.size()];
-      const IntegratorKind kind = kinds[static_cast<std::size_t>(i) % kinds.size()];
-      const std::string name(integratorName(kind));
-      const double c = opt.dampingRatio * p.k, zeta = opt.dampingRatio * p.wMax / 2.0;
-      const double predicted = predictedThreshold(kind, p.wMax, opt.dampingRatio);
-      table.add({p.scene, name, p.k, c, p.wMax, zeta, std::string("predicted"), predicted,
-                 predicted * p.wMax,
-                 std::string(std::isinf(predicted) ? "unconditional"
-                             : predicted > 0.0     ? "limit"
-                                                   : "never"),
-                 0L, 0.0});
-      // The search starts at Courant number 1 for every method, not at its prediction, so the
-      // measurement does not lean on what it is compared with.
-      const double guess = 1.0 / p.wMax;
-      const auto t0 = std::chrono::steady_clock::now();
-      const Threshold t =
-          findThreshold(p.world, kind, opt.rule, guess, opt.dtMax, opt.tolerance, 1e-8, solver);
-      const double wall =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      const std::string outcome = t.stableToMax()  ? "stable_to_max"
-                                  : t.stable > 0.0 ? "threshold"
-                                                   : "unstable_to_min";
-      table.add({p.scene, name, p.k, c, p.wMax, zeta, std::string("measured"), t.stable,
-                 t.stable * p.wMax, outcome, long(t.trials), wall});
-    });
-  } catch (const std::exception& e) {
-    std::cerr << "jello-stability: error: " << e.what() << '\n';
-    return 1;
-  }
+  const bool ok =
+      ranks.run("jello-stability", tasks, opt.jobs, "grid points", !opt.quiet,
+                [&](int i) {
+                  const Point& p = points[static_cast<std::size_t>(i) / kinds.size()];
+                  const IntegratorKind kind = kinds[static_cast<std::size_t>(i) % kinds.size()];
+                  const std::string name(integratorName(kind));
+                  const double c = opt.dampingRatio * p.k, zeta = opt.dampingRatio * p.wMax / 2.0;
+                  const double predicted = predictedThreshold(kind, p.wMax, opt.dampingRatio);
+                  table.add({p.scene, name, p.k, c, p.wMax, zeta, std::string("predicted"),
+                             predicted, predicted * p.wMax,
+                             std::string(std::isinf(predicted) ? "unconditional"
+                                         : predicted > 0.0     ? "limit"
+                                                               : "never"),
+                             0L, 0.0});
+                  // The search starts at Courant number 1 for every method, not at its prediction,
+                  // so the measurement does not lean on what it is compared with.
+                  const double guess = 1.0 / p.wMax;
+                  const auto t0 = std::chrono::steady_clock::now();
+                  const Threshold t = findThreshold(p.world, kind, opt.rule, guess, opt.dtMax,
+                                                    opt.tolerance, 1e-8, solver);
+                  const double wall =
+                      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+                  const std::string outcome = t.stableToMax()  ? "stable_to_max"
+                                              : t.stable > 0.0 ? "threshold"
+                                                               : "unstable_to_min";
+                  table.add({p.scene, name, p.k, c, p.wMax, zeta, std::string("measured"), t.stable,
+                             t.stable * p.wMax, outcome, long(t.trials), wall});
+                },
+                {&table});
+  if (!ok) return 1;
 
   nlohmann::json sidecar = context;
   sidecar["program"] = "jello-stability";
@@ -206,8 +210,8 @@ int main(int argc, char** argv) {
   sidecar["wall_time_s"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   const std::filesystem::path dir = opt.outDir;
-  if (!writeResults("jello-stability", dir, opt.name, table, sidecar)) return 1;
-  if (!opt.quiet) {
+  if (!ranks.writeOutput("jello-stability", dir, opt.name, table, sidecar)) return 1;
+  if (!opt.quiet && ranks.root()) {
     std::printf("wrote %zu rows to %s (%.1f s)\n", table.rows(),
                 (dir / (opt.name + ".csv")).c_str(), sidecar["wall_time_s"].get<double>());
   }
