@@ -24,7 +24,7 @@ do for [scene in scenes] {
       set title 'Work-precision, '.scene.' scene: '.(q eq "position" ? 'largest position error over the window (m)' : 'largest energy error over the window, relative to E(0)')
       set xlabel 'wall time of the steps (s; median, bars: min to max of the repeats)'
       set ylabel (q eq "position" ? 'max_t max_i |x_i - x_{ref}| (m)' : 'max_t |E - E_{ref}| / E_{ref}(0)')
-      plot for [i=1:9] sel(scene, word(integrators,i), 'none') using 10:col:11:12 with xerrorlines pt word(points,i)+0 lw 2 lc rgb word(colors,i) title word(integrators,i), \
+      plot for [i=1:9] sel(scene, word(integrators,i), 'none') using 10:col:11:12 with xerrorlines pt (word(points,i)+0) lw 2 lc rgb word(colors,i) title word(integrators,i), \
            sel(scene, 'cvode', 'bdf') using 10:col:11:12 with xerrorlines pt 5 lw 2 lc rgb '#ff7f0e' title 'cvode, BDF', \
            sel(scene, 'cvode', 'adams') using 10:col:11:12 with xerrorlines pt 9 lw 2 lc rgb '#8c564b' title 'cvode, Adams'
       set output

@@ -3,6 +3,8 @@
 #include <sys/utsname.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -12,6 +14,9 @@
 
 #include "solvers/solver_threads.h"
 #include "src/atomic_file.h"
+#include "src/model.h"
+#include "src/scene_builder.h"
+#include "src/state.h"
 
 namespace jello::experiments {
 
@@ -34,6 +39,27 @@ std::string cpuModel() {
     if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
   }
   return "unknown";
+}
+
+// The machine's speed as the run starts: the median over 9 batches of the time of one force
+// evaluation (springs, walls, plane, field) of the default scene's 8^3 cube. These are shared
+// VMs: the same machine type measured the spring forces 4x apart on one day, so timings are
+// comparable within a run, and across runs only through this figure.
+double forceEvaluationSeconds() {
+  SceneSpec spec;
+  const World w = buildWorld(spec);
+  const Model model(w);
+  const State s = initialState(w);
+  Eigen::VectorXd f(s.x.size());
+  std::vector<double> batches;
+  for (int b = 0; b < 9; ++b) {
+    const auto t0 = std::chrono::steady_clock::now();
+    for (int i = 0; i < 50; ++i) model.forces(s.x.data(), s.v.data(), f.data());
+    batches.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() /
+                      50);
+  }
+  std::nth_element(batches.begin(), batches.begin() + 4, batches.end());
+  return batches[4];
 }
 
 }  // namespace
@@ -62,7 +88,8 @@ nlohmann::json runContext(int argc, char** argv) {
        {{"cpu", cpuModel()},
         {"cores", std::thread::hardware_concurrency()},
         {"kernel", named ? std::string(u.sysname) + " " + u.release : "unknown"},
-        {"arch", named ? u.machine : "unknown"}}},
+        {"arch", named ? u.machine : "unknown"},
+        {"force_evaluation_8_s", forceEvaluationSeconds()}}},
       {"date_utc", date}};
 }
 

@@ -62,6 +62,7 @@ struct Scene {
   Trajectory reference;
   double referenceCheck = 0.0;  // m, max over the samples of |reference - rk4 at twice its step|
   double referenceStep = 0.0;   // s
+  double referenceHw = 0.05;    // h w_max of the reference's RK4 steps
 };
 
 // The errors of a run against the reference over the whole window, at every sample.
@@ -247,20 +248,23 @@ int main(int argc, char** argv) {
   try {
     const std::filesystem::path dir(worldsDir);
     const World soft = readWorld(dir / "jello.w");
-    std::vector<std::tuple<std::string, std::string, World, double>> list;
+    // Name, description, world, window (s), h w_max of the reference.
+    std::vector<std::tuple<std::string, std::string, World, double, double>> list;
     if (quick) {
-      list.emplace_back("soft", "jello.w, 0.04 s (before its first contact)", soft, 0.04);
+      list.emplace_back("soft", "jello.w, 0.04 s (before its first contact)", soft, 0.04, 0.05);
     } else {
       // 0.25 s: the first contact with the floor and the plane and the rebound. Over longer
       // windows no reference converges: the contacts' damping switches on abruptly (no method
-      // is better than first order through it) and differences grow after every contact.
-      list.emplace_back("soft", "jello.w, 0.25 s (its first contact and rebound)", soft, 0.25);
+      // is better than first order through it) and differences grow after every contact. For
+      // that first order, its reference takes 8x smaller steps.
+      list.emplace_back("soft", "jello.w, 0.25 s (its first contact and rebound)", soft, 0.25,
+                        0.00625);
       list.emplace_back("drop", "sphere-drop.w, 2 s (falls onto the sphere and the floor)",
-                        readWorld(dir / "sphere-drop.w"), 2.0);
+                        readWorld(dir / "sphere-drop.w"), 2.0, 0.05);
       list.emplace_back("stiff", "free cube, k = 1e4, undamped, stretched 5% and spinning, 0.2 s",
-                        stiffScene(stiffK, 0.0), 0.2);
+                        stiffScene(stiffK, 0.0), 0.2, 0.05);
     }
-    for (auto& [label, description, w, time] : list) {
+    for (auto& [label, description, w, time, hw] : list) {
       const Model model(w);
       scenes.push_back({label,
                         description,
@@ -270,14 +274,16 @@ int main(int argc, char** argv) {
                         maxAngularFrequency(model, initialState(w)),
                         {},
                         0.0,
-                        0.0});
+                        0.0,
+                        hw});
     }
-    // The references: RK4 at h w_max <= 0.05 (CVODE at rtol 1e-11 took many minutes over
+    // The references: RK4 at h w_max <= 0.05 or less (CVODE at rtol 1e-11 took minutes over
     // windows with contact), checked against RK4 at twice its step: fourth order makes that
     // check about 16x the reference's own error where the motion is smooth. One scene a thread.
     parallelFor(int(scenes.size()), jobs, "references", !quiet && ranks.root(), [&](int i) {
       Scene& s = scenes[static_cast<std::size_t>(i)];
-      const double tiny = interval / std::pow(2.0, std::ceil(std::log2(interval * s.wMax / 0.05)));
+      const double tiny =
+          interval / std::pow(2.0, std::ceil(std::log2(interval * s.wMax / s.referenceHw)));
       Run ref = run(s.world, IntegratorKind::RK4, tiny, s.time, interval, {}, nullptr, true);
       if (!ref.failure.empty()) throw std::runtime_error(s.name + " reference: " + ref.failure);
       s.reference = std::move(ref.trajectory);
@@ -433,6 +439,7 @@ int main(int argc, char** argv) {
                          {"w_max_rad_per_s", s.wMax},
                          {"reference", "rk4"},
                          {"reference_dt_s", s.referenceStep},
+                         {"reference_h_w_max", s.referenceHw},
                          {"reference_vs_twice_its_step_m", s.referenceCheck}});
   }
   sidecar["parameters"] = {
