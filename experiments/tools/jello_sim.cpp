@@ -13,12 +13,12 @@
 #include <optional>
 #include <sstream>
 #include <string>
-#include <tuple>
 #include <utility>
 #include <vector>
 
 #include "experiments/common/progress.h"
 #include "experiments/common/signal_handler.h"
+#include "experiments/tools/output_check.h"
 #include "solvers/modes.h"
 #include "solvers/simulation.h"
 #include "solvers/solver_threads.h"
@@ -111,34 +111,12 @@ void warnOfLightlyDampedStiffness(const Simulation& sim, double simulated, doubl
 }
 
 int run(const Options& opt) {
-  // Every output is checked before the run: a bad --stats path must not be found after an
-  // hour. Two outputs to one file would overwrite each other.
-  {
-    std::vector<std::pair<const char*, std::string>> outputs;
-    const std::tuple<const char*, const std::string*, bool> flags[] = {
-        {"--out", &opt.out, opt.outGiven},
-        {"--stats", &opt.stats, opt.statsGiven},
-        {"--trace", &opt.trace, opt.traceGiven}};
-    for (const auto& [flag, path, given] : flags) {
-      if (given) outputs.emplace_back(flag, *path);
-    }
-    bool bad = false;
-    for (std::size_t i = 0; i < outputs.size(); ++i) {
-      if (const std::string why = jello::outputProblem(outputs[i].second); !why.empty()) {
-        std::fprintf(stderr, "jello-sim: error: cannot write %s (%s): %s\n",
-                     outputs[i].second.c_str(), outputs[i].first, why.c_str());
-        bad = true;
-      }
-      for (std::size_t j = 0; j < i; ++j) {
-        if (!outputs[i].second.empty() && outputs[i].second == outputs[j].second) {
-          std::fprintf(stderr, "jello-sim: error: %s and %s name the same file %s\n",
-                       outputs[j].first, outputs[i].first, outputs[i].second.c_str());
-          bad = true;
-        }
-      }
-    }
-    if (bad) return kExitInput;  // an I/O failure, found before the run
-  }
+  // Every output is checked before the run (an I/O failure, found before it starts).
+  std::vector<jello::PlannedOutput> outputs;
+  if (opt.outGiven) outputs.push_back({"--out", opt.out});
+  if (opt.statsGiven) outputs.push_back({"--stats", opt.stats});
+  if (opt.traceGiven) outputs.push_back({"--trace", opt.trace});
+  if (!jello::checkOutputs("jello-sim", outputs)) return kExitInput;
   jello::World world;
   try {
     jello::ReaderLimits limits = opt.limits;

@@ -59,7 +59,11 @@ def other_tables():
     return {"cvode-stiff": stiff.table(stiff.committed_rows()),
             "viewer-speed": load("scripts/viewer-table.py").table(),
             "python-overhead": overhead.table(data),
-            "stability-summary": load("scripts/results-tables.py").stability_summary()}
+            "stability-summary": load("scripts/results-tables.py").stability_summary(),
+            "work-precision-summary":
+                load("scripts/results-tables.py").work_precision_summary(),
+            "implicit-damping": load("scripts/results-tables.py").implicit_damping(),
+            "scaling-summary": load("scripts/results-tables.py").scaling_summary()}
 
 
 @pytest.mark.parametrize("tables", [speed_tables, integrator_tables, other_tables])
