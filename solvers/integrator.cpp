@@ -8,6 +8,14 @@
 
 namespace jello {
 
+std::optional<double> findStatistic(const std::vector<Statistic>& statistics,
+                                    std::string_view name) {
+  for (const Statistic& s : statistics) {
+    if (s.name == name) return s.value;
+  }
+  return std::nullopt;
+}
+
 // Built from the one table of integrators (src/integrator_name.h): each row names its class.
 std::unique_ptr<Integrator> makeIntegrator(IntegratorKind kind, const SolverOptions& options) {
   switch (kind) {

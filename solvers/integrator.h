@@ -4,7 +4,9 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "solvers/solver_options.h"
@@ -20,6 +22,10 @@ struct Statistic {
   std::string name;  // snake_case with its unit, e.g. "factor_time_s"
   double value;
 };
+
+// The value of the statistic called `name`, when `statistics` has one.
+std::optional<double> findStatistic(const std::vector<Statistic>& statistics,
+                                    std::string_view name);
 
 class Integrator {
  public:

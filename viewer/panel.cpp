@@ -20,10 +20,7 @@ constexpr std::array<const char*, 4> kEffortCounters{"newton_iterations", "proje
                                                      "rhs_evaluations", "cg_iterations"};
 
 std::optional<double> statistic(const Frame& frame, const char* name) {
-  for (const Statistic& s : frame.solver) {
-    if (s.name == name) return s.value;
-  }
-  return std::nullopt;
+  return findStatistic(frame.solver, name);
 }
 
 // A slider for a positive constant on a logarithmic scale; true when an edit was finished.

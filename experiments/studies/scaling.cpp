@@ -33,13 +33,6 @@ struct Task {
   LinearSolverKind solver = LinearSolverKind::Cholmod;  // implicit, cvode
 };
 
-double statistic(const Integrator& integrator, const std::string& name) {
-  for (const Statistic& s : integrator.statistics()) {
-    if (s.name == name) return s.value;
-  }
-  return std::nan("");
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -152,14 +145,17 @@ int main(int argc, char** argv) {
         const Integrator& integ = sim.integrator();
         const bool split = t.kind == IntegratorKind::Implicit || t.kind == IntegratorKind::Cvode;
         const auto perSecond = [&](const char* stat) {
-          return split ? statistic(integ, stat) / simulated : std::nan("");
+          return split ? findStatistic(integ.statistics(), stat).value_or(std::nan("")) / simulated
+                       : std::nan("");
         };
         table.add({long(t.n), long(w.numPoints()), long(3 * w.numPoints()),
                    std::string(integratorName(t.kind)),
                    std::string(split ? linearSolverName(t.solver) : "none"), k, wMax, dt,
                    sim.steps(), simulated, wall, wall / simulated, perSecond("assemble_time_s"),
                    perSecond("factor_time_s"), perSecond("solve_time_s"),
-                   split ? statistic(integ, "factorizations") : std::nan("")});
+                   split
+                       ? findStatistic(integ.statistics(), "factorizations").value_or(std::nan(""))
+                       : std::nan("")});
       },
       {&table});
   if (!ok) return 1;

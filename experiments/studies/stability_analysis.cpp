@@ -132,8 +132,6 @@ Trial runTrial(const World& world, IntegratorKind kind, double dt, const BlowUpR
                               kind == IntegratorKind::RK4;
   const long steps = std::max(explicitMethod ? rule.minSteps : 1L, std::lround(rule.time / dt));
   Trial trial;
-  double fieldWork = 0.0;  // J, done by the force field (gravity in the wall scene)
-  Eigen::VectorXd previous = sim.state().x;
   for (long i = 0; i < steps; ++i) {
     ++trial.steps;
     if (StepResult r = sim.step(); !r.ok) {
@@ -141,13 +139,11 @@ Trial runTrial(const World& world, IntegratorKind kind, double dt, const BlowUpR
       trial.reason = r.message;
       return trial;
     }
-    if (sim.model().hasField()) {
-      fieldWork += sim.model().fieldWork(previous.data(), sim.state().x.data());
-      previous = sim.state().x;
-    }
     const bool inEnvelope = i < kEnergyEnvelopeSteps;
     if (inEnvelope || (i & 3) == 3 || i + 1 == steps) {
-      const double e = sim.model().energy(sim.state()).total() - fieldWork;
+      // Net of the work the force field (the wall scene's load) has done, as the simulation
+      // counts it.
+      const double e = sim.model().energy(sim.state()).total() - sim.fieldWork();
       if (inEnvelope && e == e) {
         envelope = std::max(envelope, e);
       } else if (!(e <= rule.energyFactor * envelope)) {

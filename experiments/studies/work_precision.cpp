@@ -47,10 +47,21 @@ World stiffScene(double k, double damping, double spin = 2.0) {
   return w;
 }
 
-// States at t_k = k * interval, k = 0 .. K.
+// States at t_k = k * interval, k = 0 .. K; a reference also keeps each state's total energy
+// and angular momentum (measure()), computed once rather than by every run compared with it.
 struct Trajectory {
   double interval = 0.0;
   std::vector<State> states;
+  std::vector<double> energy;         // J
+  std::vector<Vec3> angularMomentum;  // kg m^2/s
+  void measure(const Model& model) {
+    energy.clear();
+    angularMomentum.clear();
+    for (const State& s : states) {
+      energy.push_back(model.energy(s).total());
+      angularMomentum.push_back(model.angularMomentum(s));
+    }
+  }
 };
 
 struct Scene {
@@ -75,12 +86,12 @@ struct Errors {
 
 class ErrorMeter {
  public:
+  // `reference` has been measured (Trajectory::measure) on the same scene.
   ErrorMeter(const Model& model, const Trajectory& reference)
       : model_(model), reference_(reference) {
-    energyScale_ = std::abs(model.energy(reference.states.front()).total());
-    for (const State& s : reference.states) {
-      angularScale_ = std::max(angularScale_, norm(model.angularMomentum(s)));
-    }
+    energyScale_ = std::abs(reference.energy.front());
+    for (const Vec3& l : reference.angularMomentum)
+      angularScale_ = std::max(angularScale_, norm(l));
   }
   void sample(std::size_t k, const State& s) {
     const State& r = reference_.states.at(k);
@@ -92,12 +103,13 @@ class ErrorMeter {
     squares_ += worst * worst;
     ++samples_;
     e_.energyMax = std::max(
-        e_.energyMax, std::abs(model_.energy(s).total() - model_.energy(r).total()) / energyScale_);
+        e_.energyMax, std::abs(model_.energy(s).total() - reference_.energy.at(k)) / energyScale_);
     // A scene without rotation (max |L_ref| near zero) has no relative angular momentum error.
     e_.angularMomentumMax =
         angularScale_ > 1e-9
             ? std::max(e_.angularMomentumMax,
-                       norm(model_.angularMomentum(s) - model_.angularMomentum(r)) / angularScale_)
+                       norm(model_.angularMomentum(s) - reference_.angularMomentum.at(k)) /
+                           angularScale_)
             : std::nan("");
   }
   Errors result() const {
@@ -136,7 +148,7 @@ Run run(const World& w, IntegratorKind kind, double dt, double time, double inte
   const long perSample = std::lround(interval / dt), samples = std::lround(time / interval);
   std::optional<ErrorMeter> meter;
   if (reference) meter.emplace(sim.model(), *reference);
-  if (keep) r.trajectory = {interval, {sim.state()}};
+  if (keep) r.trajectory = {interval, {sim.state()}, {}, {}};
   const long forcesBefore = sim.model().counts().springs;
   for (long k = 1; k <= samples && r.failure.empty(); ++k) {
     for (long i = 0; i < perSample; ++i) {
@@ -159,13 +171,6 @@ Run run(const World& w, IntegratorKind kind, double dt, double time, double inte
   r.statistics = sim.integrator().statistics();
   if (meter) r.errors = meter->result();
   return r;
-}
-
-double statistic(const std::vector<Statistic>& statistics, const std::string& name) {
-  for (const Statistic& s : statistics) {
-    if (s.name == name) return s.value;
-  }
-  return std::nan("");
 }
 
 double median(std::vector<double> v) {
@@ -287,6 +292,7 @@ int main(int argc, char** argv) {
       Run ref = run(s.world, IntegratorKind::RK4, tiny, s.time, interval, {}, nullptr, true);
       if (!ref.failure.empty()) throw std::runtime_error(s.name + " reference: " + ref.failure);
       s.reference = std::move(ref.trajectory);
+      s.reference.measure(Model(s.world));
       const Run check =
           run(s.world, IntegratorKind::RK4, 2 * tiny, s.time, interval, {}, &s.reference);
       if (!check.failure.empty()) throw std::runtime_error(s.name + " check: " + check.failure);
@@ -400,7 +406,9 @@ int main(int argc, char** argv) {
         const bool failed = !first.failure.empty();
         const double nan = std::nan("");
         const Errors& e = first.errors;
-        const auto stat = [&](const char* n) { return statistic(first.statistics, n); };
+        const auto stat = [&](const char* n) {
+          return findStatistic(first.statistics, n).value_or(nan);
+        };
         table.add({s.name,
                    std::string(integratorName(t.kind)),
                    std::string(cvode ? (t.method == CvodeMethod::Bdf ? "bdf" : "adams") : "none"),
