@@ -85,11 +85,15 @@ def test_the_gil_is_released_while_stepping(jello_w):
 
 
 def test_a_second_thread_cannot_step_a_busy_simulation(jello_w):
+    # No sleeps: the run's first callback lets the other thread go (it then finds the run
+    # stepping, its GIL released, whatever the machine's speed), and the run ends at the first
+    # callback after the other thread is done.
     sim = jello.Simulation(jello_w, integrator="rk4")
     errors = []
+    stepping, finished = threading.Event(), threading.Event()
 
     def other():
-        time.sleep(0.05)
+        stepping.wait(timeout=60)
         try:
             sim.step()
         except RuntimeError as e:
@@ -98,9 +102,14 @@ def test_a_second_thread_cannot_step_a_busy_simulation(jello_w):
             sim.energy()
         except RuntimeError as e:
             errors.append(str(e))
+        finished.set()
+
+    def callback(_):
+        stepping.set()
+        return not finished.is_set()
 
     thread = threading.Thread(target=other)
     thread.start()
-    sim.run(time=0.5)
+    sim.run(steps=10_000_000, callback=callback, every=100)
     thread.join()
     assert len(errors) == 2 and "busy" in errors[0] and "another thread" in errors[1]
