@@ -6,8 +6,9 @@ thresholds against their predictions, per integrator and scene, from
 experiments/results/stability.csv and its sidecar) and <!-- work-precision-summary:begin/end -->
 (per scene, each integrator's cheapest run within given position errors over the whole window,
 from experiments/results/work_precision.csv and its sidecar), <!-- implicit-damping:... -->
-and <!-- scaling-summary:... --> (cost per simulated second against N, from scaling.csv) in
-README.md. With --check it changes
+<!-- scaling-summary:... --> (cost per simulated second against N, from scaling.csv) and
+<!-- drift-summary:... --> (the long-run drift of energy and angular momentum per integrator,
+from work_precision_drift_summary.csv) in README.md. With --check it changes
 nothing and exits 1 when README.md differs from what the data gives (ctest runs it so).
 
     scripts/results-tables.py [--check]
@@ -161,7 +162,8 @@ def work_precision_summary():
 
 def implicit_damping():
     with open(os.path.join(RESULTS, "work_precision_damping.csv"), newline="") as f:
-        rows = sorted(csv.DictReader(f), key=lambda r: float(r["dt_s"]))
+        rows = sorted((r for r in csv.DictReader(f) if r["integrator"] == "implicit"),
+                      key=lambda r: float(r["dt_s"]))
     with open(os.path.join(RESULTS, "work_precision.json")) as f:
         span_s = json.load(f)["parameters"]["damping_scene"]["time_s"]
 
@@ -178,6 +180,33 @@ def implicit_damping():
             f"rates ln(E0/E)/T from {min(rates):,.0f} to {max(rates):,.0f} per second, the "
             f"fastest at dt = {float(peak['dt_s']):.2g} s (h w_max = "
             f"{float(peak['h_w_max']):.2g}).")
+
+
+def drift_summary():
+    with open(os.path.join(RESULTS, "work_precision_drift_summary.csv"), newline="") as f:
+        rows = list(csv.DictReader(f))
+    with open(os.path.join(RESULTS, "work_precision.json")) as f:
+        sidecar = json.load(f)
+        scene = sidecar["parameters"]["drift_scene"]
+    lines = [f"Undamped cube, k = {scene['k_N_per_m']:g} N/m, {scene['time_s']:g} s, sampled every "
+             f"{scene['sample_interval_s']:g} s; commit {sidecar['commit'][:7]}, "
+             f"{sidecar['date_utc'][:10]}.", "",
+             "| integrator | dt (s) | h w_max | E/E0 at the end | max \|E/E0 - 1\|, first half "
+             "| same, second half | max \|L - L0\| / \|L0\| | wall time |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        if r["outcome"] != "ok":
+            lines.append(f"| {r['integrator']} | {float(r['dt_s']):.3g} | "
+                         f"{float(r['h_w_max']):.3g} | {r['outcome']} at t = "
+                         f"{float(r['diverged_at_s']):.3g} s | | | | |")
+            continue
+        lines.append(f"| {r['integrator']} | {float(r['dt_s']):.3g} | {float(r['h_w_max']):.3g} | "
+                     f"{float(r['energy_ratio_end']):.4g} | "
+                     f"{float(r['energy_deviation_max_first_half']):.2g} | "
+                     f"{float(r['energy_deviation_max_second_half']):.2g} | "
+                     f"{float(r['angular_momentum_error_max']):.2g} | "
+                     f"{seconds(float(r['wall_time_s']))} |")
+    return "\n".join(lines)
 
 
 def scaling_summary():
@@ -231,7 +260,8 @@ def scaling_summary():
 BLOCKS = {"stability-summary": stability_summary,
           "scaling-summary": scaling_summary,
           "work-precision-summary": work_precision_summary,
-          "implicit-damping": implicit_damping}
+          "implicit-damping": implicit_damping,
+          "drift-summary": drift_summary}
 
 
 def render(text):

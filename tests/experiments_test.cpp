@@ -22,6 +22,7 @@
 #include "solvers/jacobian.h"
 #include "solvers/simulation.h"
 #include "src/scene_builder.h"
+#include "tests/experiments_support.h"
 #include "tests/test_support.h"
 
 namespace jello::experiments {
@@ -183,60 +184,6 @@ TEST(StabilityAnalysis, AboveItsContactLimitRk4ChattersOnTheFloorInsteadOfBlowin
 
 // --- the programs' --quick runs ---------------------------------------------------------------
 
-using Table = std::vector<std::map<std::string, std::string>>;
-
-Table readCsv(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::vector<std::string> columns;
-  Table rows;
-  const auto split = [](const std::string& s) {
-    std::vector<std::string> out;
-    std::stringstream ss(s);
-    for (std::string cell; std::getline(ss, cell, ',');) out.push_back(cell);
-    return out;
-  };
-  if (std::getline(in, line)) columns = split(line);
-  while (std::getline(in, line)) {
-    const auto cells = split(line);
-    std::map<std::string, std::string> row;
-    for (std::size_t i = 0; i < columns.size() && i < cells.size(); ++i) row[columns[i]] = cells[i];
-    rows.push_back(row);
-  }
-  return rows;
-}
-
-// A program's exit code, run without its progress line.
-int run(const std::string& command) {
-  return test::run(command + " --quiet").code;
-}
-
-double number(const std::map<std::string, std::string>& row, const std::string& column) {
-  return std::stod(row.at(column));
-}
-
-void expectSidecar(const std::filesystem::path& path, const char* program) {
-  std::ifstream in(path);
-  ASSERT_TRUE(in) << path;
-  const nlohmann::json j = nlohmann::json::parse(in);
-  EXPECT_EQ(j.at("program"), program);
-  for (const char* key : {"command_line", "commit", "compiler", "blas", "machine", "parameters",
-                          "date_utc", "wall_time_s"}) {
-    EXPECT_TRUE(j.contains(key)) << key;
-  }
-}
-
-// Least-squares slope of log(error) against log(dt).
-double slope(const std::vector<std::pair<double, double>>& points) {
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (auto [dt, e] : points) {
-    const double x = std::log(dt), y = std::log(e);
-    sx += x, sy += y, sxx += x * x, sxy += x * y;
-  }
-  const double n = double(points.size());
-  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
-}
-
 TEST(StabilityMapQuick, ThresholdsMeetTheirPredictionsAndImplicitNeverBlowsUp) {
   test::TempDir dir;
   ASSERT_EQ(run(std::string(JELLO_STABILITY) + " --quick --out-dir " + dir.path().string()), 0);
@@ -265,55 +212,6 @@ TEST(StabilityMapQuick, ThresholdsMeetTheirPredictionsAndImplicitNeverBlowsUp) {
   const auto& c = courant["rk4"];
   ASSERT_EQ(c.size(), 2u);
   EXPECT_LT(*std::max_element(c.begin(), c.end()) / *std::min_element(c.begin(), c.end()), 1.25);
-}
-
-TEST(WorkPrecisionQuick, ErrorsOverTheTrajectoryFallWithTheMethodsOrders) {
-  test::TempDir dir;
-  ASSERT_EQ(run(std::string(JELLO_WORK_PRECISION) + " --quick --repeats 2 --out-dir " +
-                dir.path().string()),
-            0);
-  expectSidecar(dir.path() / "work_precision.json", "jello-work-precision");
-  std::map<std::string, std::vector<std::pair<double, double>>> errors;
-  std::vector<std::pair<double, double>> bdf;
-  for (const auto& r : readCsv(dir.path() / "work_precision.csv")) {
-    EXPECT_EQ(r.at("outcome"), "ok") << r.at("integrator") << " dt " << r.at("dt_s");
-    // Timings: the median of 2 runs lies within their spread; set-up is timed apart.
-    EXPECT_EQ(r.at("repeats"), "2");
-    EXPECT_GT(number(r, "wall_time_s"), 0.0);
-    EXPECT_LE(number(r, "wall_time_min_s"), number(r, "wall_time_s"));
-    EXPECT_GE(number(r, "wall_time_max_s"), number(r, "wall_time_s"));
-    EXPECT_GT(number(r, "setup_s"), 0.0);
-    EXPECT_LE(number(r, "first_step_s"), number(r, "wall_time_max_s"));
-    // The RMS over samples of the worst point cannot exceed the maximum over them.
-    const double e = number(r, "position_error_max_m");
-    EXPECT_LE(number(r, "position_error_rms_m"), e * (1 + 1e-12));
-    EXPECT_GE(number(r, "force_evaluations"), number(r, "steps"));
-    if (r.at("integrator") == "cvode") {
-      EXPECT_EQ(r.at("cvode_method"), "bdf");
-      EXPECT_GE(number(r, "cvode_steps"), 1.0);
-      bdf.emplace_back(number(r, "rtol"), e);
-    } else {
-      errors[r.at("integrator")].emplace_back(number(r, "dt_s"), e);
-    }
-    if (r.at("integrator") == "rk4") {  // one force evaluation per stage
-      EXPECT_EQ(number(r, "force_evaluations"), 4 * number(r, "steps"));
-    }
-    if (r.at("integrator") == "implicit") {
-      EXPECT_GE(number(r, "newton_iterations"), 1.0);
-    }
-  }
-  ASSERT_EQ(errors["rk4"].size(), 3u);
-  ASSERT_EQ(errors["implicit"].size(), 3u);
-  EXPECT_NEAR(slope(errors["euler"]), 1.0, 0.35);
-  EXPECT_NEAR(slope(errors["implicit"]), 1.0, 0.35);
-  EXPECT_NEAR(slope(errors["symplectic"]), 1.0, 0.35);
-  EXPECT_NEAR(slope(errors["rk4"]), 4.0, 0.6);
-  std::sort(bdf.begin(), bdf.end());
-  ASSERT_EQ(bdf.size(), 3u);
-  EXPECT_LT(bdf[0].second, bdf[2].second);  // tighter tolerance, smaller error
-  const Table damping = readCsv(dir.path() / "work_precision_damping.csv");
-  ASSERT_FALSE(damping.empty());
-  for (const auto& r : damping) EXPECT_GT(number(r, "energy_decay_rate_per_s"), 0.0);
 }
 
 TEST(ScalingQuick, EveryIntegratorAndSizeHasItsCostAndTheImplicitSplit) {

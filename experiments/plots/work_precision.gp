@@ -1,6 +1,7 @@
 # Work-precision from work_precision.csv (errors over the whole window against wall time, the
-# median of the repeats with their spread as horizontal bars) and backward Euler's artificial
-# damping from work_precision_damping.csv.
+# median of the repeats with their spread as horizontal bars), the artificial damping of
+# backward Euler, BDF2 and midpoint against the linear theory (work_precision_damping.csv) and
+# the long-run drift (work_precision_drift.csv).
 # gnuplot -e "dir='experiments/results'" experiments/plots/work_precision.gp
 if (!exists("dir")) dir = 'experiments/results'
 if (!exists("scenes")) scenes = 'soft drop stiff'  # the scenes the CSV holds (--quick: soft)
@@ -36,10 +37,41 @@ damping = dir.'/work_precision_damping.csv'
 do for [fmt in "pngcairo svg"] {
   if (fmt eq "pngcairo") { set terminal pngcairo size 760,480 font ",10"; set output dir.'/implicit_damping.png' } \
   else { set terminal svg size 760,480 font ",10"; set output dir.'/implicit_damping.svg' }
-  set title "Backward Euler's artificial damping: undamped stiff cube (k = 10^4), first 0.02 s"
+  set title "Artificial damping: undamped stiff cube (k = 10^4), first 0.02 s; lines: linear theory on its modes"
   set xlabel 'dt (s)'
   set ylabel 'energy decay rate ln(E_0/E)/T (1/s)'
-  unset key
-  plot damping every ::1 using 3:9 with linespoints pt 7 lw 2 lc rgb '#9467bd'
+  set logscale x
+  unset logscale y
+  set key inside left top
+  dmp(integ) = sprintf("< awk -F, '$2==\"%s\"' %s | sort -t, -k3,3g", integ, damping)
+  plot dmp('implicit') using 3:12 with lines lw 2 lc rgb '#9467bd' title 'implicit, theory', \
+       dmp('implicit') using 3:9 with points pt 7 ps 1.2 lc rgb '#9467bd' title 'implicit, measured', \
+       dmp('bdf2') using 3:12 with lines lw 2 lc rgb '#e377c2' title 'bdf2, theory', \
+       dmp('bdf2') using 3:9 with points pt 11 ps 1.2 lc rgb '#e377c2' title 'bdf2, measured', \
+       dmp('midpoint') using 3:9 with points pt 9 ps 1.2 lc rgb '#17becf' title 'midpoint, measured (theory: 0)'
+  set output
+}
+
+# Long-run drift (work_precision_drift.csv): the undamped spinning cube's energy and angular
+# momentum over the whole run, per integrator (forward Euler's run ends where it diverged).
+drift = dir.'/work_precision_drift.csv'
+dsel(integ) = sprintf("< awk -F, '$1==\"%s\"' %s", integ, drift)
+do for [fmt in "pngcairo svg"] {
+  if (fmt eq "pngcairo") { set terminal pngcairo size 980,820 font ",10"; set output dir.'/work_precision_drift.png' } \
+  else { set terminal svg size 980,820 font ",10"; set output dir.'/work_precision_drift.svg' }
+  set multiplot layout 2,1 title "Long-run drift: undamped spinning cube (no damping, touching nothing), explicit methods at half their limit, the others at dt = 0.01 s"
+  unset logscale
+  set logscale y
+  set key outside right top
+  set xlabel 't (s)'
+  set ylabel 'total energy E(t) / E(0)'
+  set yrange [1e-3:10]
+  plot for [i=1:9] dsel(word(integrators,i)) using 3:5 with lines lw 2 lc rgb word(colors,i) title word(integrators,i)
+  set ylabel '|L(t) - L(0)| / |L(0)|'
+  set yrange [1e-16:10]
+  set format y '10^{%L}'
+  plot for [i=1:9] dsel(word(integrators,i)) using 3:($6 > 0 ? $6 : 1/0) with lines lw 2 lc rgb word(colors,i) title word(integrators,i)
+  set format y
+  unset multiplot
   set output
 }

@@ -73,6 +73,15 @@ double predictedThreshold(IntegratorKind kind, double wMax, double dampingRatio)
   return lo;
 }
 
+World spinningStiffCube(double k, double damping, double spin) {
+  SceneSpec spec = vibratingStiffCube(k);
+  spec.dElastic = damping;
+  spec.spin = spin;
+  World w = buildWorld(spec);
+  for (Vec3& p : w.positions) p += Vec3{-0.5, -0.5, -0.5};
+  return w;
+}
+
 World stabilityScene(std::string_view scene, double k, double dampingRatio, double contactRatio) {
   SceneSpec spec = stiffCube(k);
   spec.dElastic = dampingRatio * k;

@@ -44,6 +44,11 @@ double predictedThreshold(IntegratorKind kind, double wMax, double dampingRatio)
 World stabilityScene(std::string_view scene, double k, double dampingRatio,
                      double contactRatio = 20.0);
 
+// The stiff cube of work-precision and the drift run: stretched 5% along x and spinning at
+// `spin` rad/s about z (scene_builder.h's vibratingStiffCube), springs k, damping c, centred in
+// the box (walls 1.5 m away, never reached), no field, no plane.
+World spinningStiffCube(double k, double damping, double spin = 2.0);
+
 // "Blew up": within the run, a step produced a non-finite or far state (the simulation's
 // divergence check, bound 100 m) or the total energy (kinetic + spring + contact, minus the work
 // the force field has done) rose above energyFactor times its envelope, the largest energy of

@@ -3,7 +3,8 @@
 // stiffness in their windows (jello.w for 1 s, a 2 s drop onto the sphere, an undamped spinning
 // stiff cube), against a converged reference sampled every interval; timings are medians of
 // repeated runs with set-up apart, and the solvers' work is counted. Also backward Euler's
-// artificial damping on the undamped stiff cube.
+// artificial damping on the undamped stiff cube, and every integrator's long-run drift of
+// energy and angular momentum on an undamped free cube (drift.h).
 //   jello-work-precision [--quick] [--levels N] [--repeats N] [--out-dir DIR] [--jobs N]
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -16,10 +17,13 @@
 
 #include "experiments/common/signal_handler.h"
 #include "experiments/studies/csv_table.h"
+#include "experiments/studies/drift.h"
+#include "experiments/studies/mode_theory.h"
 #include "experiments/studies/parallel_for.h"
 #include "experiments/studies/ranks.h"
 #include "experiments/studies/run_context.h"
 #include "experiments/studies/stability_analysis.h"
+#include "experiments/studies/trajectory_run.h"
 #include "solvers/simulation.h"
 #include "solvers/solver_threads.h"
 #include "src/finite_options.h"
@@ -31,39 +35,6 @@ namespace {
 
 using namespace jello;
 using namespace jello::experiments;
-using Clock = std::chrono::steady_clock;
-
-double since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-// vibratingStiffCube with the given damping and spin, centred in the box.
-World stiffScene(double k, double damping, double spin = 2.0) {
-  SceneSpec spec = vibratingStiffCube(k);
-  spec.dElastic = damping;
-  spec.spin = spin;
-  World w = buildWorld(spec);
-  for (Vec3& p : w.positions) p += Vec3{-0.5, -0.5, -0.5};
-  return w;
-}
-
-// States at t_k = k * interval, k = 0 .. K; a reference also keeps each state's total energy
-// and angular momentum (measure()), computed once rather than by every run compared with it.
-struct Trajectory {
-  double interval = 0.0;
-  std::vector<State> states;
-  std::vector<double> energy;         // J
-  std::vector<Vec3> angularMomentum;  // kg m^2/s
-  void measure(const Model& model) {
-    energy.clear();
-    angularMomentum.clear();
-    for (const State& s : states) {
-      energy.push_back(model.energy(s).total());
-      angularMomentum.push_back(model.angularMomentum(s));
-    }
-  }
-};
-
 struct Scene {
   std::string name, description;
   World world;
@@ -75,103 +46,6 @@ struct Scene {
   double referenceStep = 0.0;   // s
   double referenceHw = 0.05;    // h w_max of the reference's RK4 steps
 };
-
-// The errors of a run against the reference over the whole window, at every sample.
-struct Errors {
-  double positionMax = 0.0;         // m, max over samples and points of |x - x_ref|
-  double positionRms = 0.0;         // m, RMS over samples of the max over points
-  double energyMax = 0.0;           // max over samples of |E - E_ref| / E_ref(0)
-  double angularMomentumMax = 0.0;  // max over samples of |L - L_ref| / max |L_ref|
-};
-
-class ErrorMeter {
- public:
-  // `reference` has been measured (Trajectory::measure) on the same scene.
-  ErrorMeter(const Model& model, const Trajectory& reference)
-      : model_(model), reference_(reference) {
-    energyScale_ = std::abs(reference.energy.front());
-    for (const Vec3& l : reference.angularMomentum)
-      angularScale_ = std::max(angularScale_, norm(l));
-  }
-  void sample(std::size_t k, const State& s) {
-    const State& r = reference_.states.at(k);
-    double worst = 0.0;
-    for (int p = 0; p < s.numPoints(); ++p) {
-      worst = std::max(worst, norm(s.position(p) - r.position(p)));
-    }
-    e_.positionMax = std::max(e_.positionMax, worst);
-    squares_ += worst * worst;
-    ++samples_;
-    e_.energyMax = std::max(
-        e_.energyMax, std::abs(model_.energy(s).total() - reference_.energy.at(k)) / energyScale_);
-    // A scene without rotation (max |L_ref| near zero) has no relative angular momentum error.
-    e_.angularMomentumMax =
-        angularScale_ > 1e-9
-            ? std::max(e_.angularMomentumMax,
-                       norm(model_.angularMomentum(s) - reference_.angularMomentum.at(k)) /
-                           angularScale_)
-            : std::nan("");
-  }
-  Errors result() const {
-    Errors e = e_;
-    e.positionRms = samples_ ? std::sqrt(squares_ / double(samples_)) : 0.0;
-    return e;
-  }
-
- private:
-  const Model& model_;
-  const Trajectory& reference_;
-  double energyScale_ = 0.0, angularScale_ = 0.0, squares_ = 0.0;
-  long samples_ = 0;
-  Errors e_;
-};
-
-// One timed run over the window: set-up (the Simulation's construction), the first step (where
-// the implicit integrators analyse and factor) and every step's time, taken apart from the
-// error sampling.
-struct Run {
-  double setup = 0.0, firstStep = 0.0, steps = 0.0;  // s
-  long count = 0;
-  long forceEvaluations = 0;
-  std::vector<Statistic> statistics;
-  std::string failure;  // empty when every step succeeded
-  Errors errors;
-  Trajectory trajectory;  // when asked to keep it
-};
-
-Run run(const World& w, IntegratorKind kind, double dt, double time, double interval,
-        const SolverOptions& options, const Trajectory* reference, bool keep = false) {
-  Run r;
-  const auto t0 = Clock::now();
-  Simulation sim(w, kind, dt, options);
-  r.setup = since(t0);
-  const long perSample = std::lround(interval / dt), samples = std::lround(time / interval);
-  std::optional<ErrorMeter> meter;
-  if (reference) meter.emplace(sim.model(), *reference);
-  if (keep) r.trajectory = {interval, {sim.state()}, {}, {}};
-  const long forcesBefore = sim.model().counts().springs;
-  for (long k = 1; k <= samples && r.failure.empty(); ++k) {
-    for (long i = 0; i < perSample; ++i) {
-      const auto s0 = Clock::now();
-      const StepResult result = sim.step();
-      const double seconds = since(s0);
-      (r.count == 0 ? r.firstStep : r.steps) += seconds;
-      ++r.count;
-      if (!result.ok) {
-        r.failure = result.message;
-        break;
-      }
-    }
-    if (!r.failure.empty()) break;
-    if (meter) meter->sample(std::size_t(k), sim.state());
-    if (keep) r.trajectory.states.push_back(sim.state());
-  }
-  r.steps += r.firstStep;
-  r.forceEvaluations = sim.model().counts().springs - forcesBefore;
-  r.statistics = sim.integrator().statistics();
-  if (meter) r.errors = meter->result();
-  return r;
-}
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -221,6 +95,13 @@ int main(int argc, char** argv) {
   app.add_option("--stiff-k", stiffK, "Stiffness of the stiff scene, N/m")
       ->check(jello::cli::positive())
       ->capture_default_str();
+  DriftSetup drift;
+  app.add_option("--drift-time", drift.time,
+                 "Length of the long-run drift runs, s (default 100; --quick: 3)")
+      ->check(jello::cli::range(0.1, 1e5));
+  app.add_option("--drift-k", drift.k, "Stiffness of the drift runs' undamped cube, N/m")
+      ->check(jello::cli::positive())
+      ->capture_default_str();
   app.add_option("--worlds", worldsDir, "Directory holding jello.w and sphere-drop.w")
       ->capture_default_str();
   app.add_option("--jobs", jobs, "Runs in parallel (per MPI rank)")
@@ -245,6 +126,7 @@ int main(int argc, char** argv) {
   if (!ranks.prepareOutput("jello-work-precision", outDir, name)) return 1;
   if (quick && app.count("--levels") == 0) levels = 3;
   if (quick && app.count("--repeats") == 0) repeats = 1;
+  if (quick && app.count("--drift-time") == 0) drift.time = 3.0;
   const std::vector<double> rtols =
       quick ? std::vector<double>{1e-3, 1e-5, 1e-7}
             : std::vector<double>{1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8};
@@ -267,7 +149,7 @@ int main(int argc, char** argv) {
       list.emplace_back("drop", "sphere-drop.w, 2 s (falls onto the sphere and the floor)",
                         readWorld(dir / "sphere-drop.w"), 2.0, 0.05);
       list.emplace_back("stiff", "free cube, k = 1e4, undamped, stretched 5% and spinning, 0.2 s",
-                        stiffScene(stiffK, 0.0), 0.2, 0.05);
+                        spinningStiffCube(stiffK, 0.0), 0.2, 0.05);
     }
     for (auto& [label, description, w, time, hw] : list) {
       const Model model(w);
@@ -333,15 +215,29 @@ int main(int argc, char** argv) {
       for (double rtol : rtols) tasks.push_back({s, IntegratorKind::Cvode, interval, method, rtol});
     }
   }
-  // Backward Euler's artificial damping: the stiff cube without any damping (and without spin,
-  // so all its energy is vibration) keeps its energy exactly; whatever the implicit step loses
-  // is numerical. Measured over 0.02 s: over longer spans every step size removes almost all.
-  const World undamped = stiffScene(stiffK, 0.0, 0.0);
+  // Artificial damping: the stiff cube without any damping (and without spin, so all its energy
+  // is vibration) keeps its energy exactly; whatever a step loses is numerical. Measured over
+  // 0.02 s (over longer spans backward Euler removes almost all at every step size) for
+  // backward Euler, BDF2 and midpoint, beside the linear theory's prediction (mode_theory.h).
+  const World undamped = spinningStiffCube(stiffK, 0.0, 0.0);
   const double dampingTime = 0.02;
-  std::vector<double> dampingSteps;
-  for (double dt = 0.01; dampingSteps.size() < std::size_t(quick ? 2 : 8); dt /= 2.0) {
-    dampingSteps.push_back(dt);
+  std::vector<std::pair<IntegratorKind, double>> dampingRuns;
+  for (IntegratorKind kind :
+       {IntegratorKind::Implicit, IntegratorKind::Bdf2, IntegratorKind::Midpoint}) {
+    double dt = 0.01;
+    for (int l = 0; l < (quick ? 2 : 8); ++l, dt /= 2.0) dampingRuns.emplace_back(kind, dt);
   }
+  ModalDecomposition undampedModes;
+  try {
+    undampedModes = decomposeOnRestModes(undamped);
+  } catch (const std::exception& e) {
+    std::cerr << "jello-work-precision: error: " << e.what() << '\n';
+    return 1;
+  }
+
+  const World driftWorld = driftScene(drift);
+  const std::vector<DriftRun> driftRuns = driftPlan(driftWorld, drift, quick);
+  CsvTable driftSeries = driftSeriesTable(), driftSummary = driftSummaryTable();
 
   CsvTable table({"scene",
                   "integrator",
@@ -366,23 +262,32 @@ int main(int argc, char** argv) {
                   "cvode_steps",
                   "outcome"});
   CsvTable damping({"scene", "integrator", "dt_s", "h_w_max", "steps", "energy_start_J",
-                    "energy_end_J", "energy_loss_J_per_s", "energy_decay_rate_per_s"});
-  const int total = int(tasks.size() + dampingSteps.size());
+                    "energy_end_J", "energy_loss_J_per_s", "energy_decay_rate_per_s",
+                    "energy_ratio", "predicted_energy_ratio", "predicted_decay_rate_per_s"});
+  const std::size_t driftFirst = tasks.size() + dampingRuns.size();
+  const int total = int(driftFirst + driftRuns.size());
   const auto started = Clock::now();
   const bool ok = ranks.run(
       "jello-work-precision", total, jobs, "runs", !quiet,
       [&](int i) {
+        if (i >= int(driftFirst)) {
+          const DriftRun& r = driftRuns[static_cast<std::size_t>(i) - driftFirst];
+          runDrift(driftWorld, r, drift, driftSeries, driftSummary);
+          return;
+        }
         if (i >= int(tasks.size())) {
-          const double dt = dampingSteps[static_cast<std::size_t>(i) - tasks.size()];
+          const auto [kind, dt] = dampingRuns[static_cast<std::size_t>(i) - tasks.size()];
           const Model model(undamped);
           const double e0 = model.energy(initialState(undamped)).total();
-          const Run r =
-              run(undamped, IntegratorKind::Implicit, dt, dampingTime, dt, {}, nullptr, true);
+          const Run r = run(undamped, kind, dt, dampingTime, dt, {}, nullptr, true);
           if (!r.failure.empty()) throw std::runtime_error("damping run: " + r.failure);
           const double e1 = model.energy(r.trajectory.states.back()).total();
-          damping.add({std::string("stiff_undamped"), std::string("implicit"), dt,
+          const double predicted =
+              predictedEnergy(undampedModes, kind, dt, r.count) / undampedModes.energy();
+          damping.add({std::string("stiff_undamped"), std::string(integratorName(kind)), dt,
                        dt * maxAngularFrequency(model, initialState(undamped)), r.count, e0, e1,
-                       (e0 - e1) / dampingTime, std::log(e0 / e1) / dampingTime});
+                       (e0 - e1) / dampingTime, std::log(e0 / e1) / dampingTime, e1 / e0, predicted,
+                       -std::log(predicted) / dampingTime});
           return;
         }
         const Task& t = tasks[static_cast<std::size_t>(i)];
@@ -432,7 +337,7 @@ int main(int argc, char** argv) {
                    stat("cvode_steps"),
                    std::string(failed ? "failed" : "ok")});
       },
-      {&table, &damping});
+      {&table, &damping, &driftSeries, &driftSummary});
   if (!ok) return 1;
 
   nlohmann::json sidecar = context;
@@ -460,7 +365,16 @@ int main(int argc, char** argv) {
        {{"k_N_per_m", stiffK},
         {"c_Ns_per_m", 0.0},
         {"time_s", dampingTime},
-        {"pose", "stretched 5% along x, at rest"}}},
+        {"pose", "stretched 5% along x, at rest"},
+        {"prediction", "linear theory on the modes at rest (experiments/studies/mode_theory.h)"}}},
+      {"drift_scene",
+       {{"k_N_per_m", drift.k},
+        {"c_Ns_per_m", 0.0},
+        {"time_s", drift.time},
+        {"sample_interval_s", drift.interval},
+        {"implicit_dt_s", drift.implicitDt},
+        {"explicit_fraction_of_limit", drift.explicitFraction},
+        {"pose", "stretched 5% along x, spinning at 2 rad/s about z, touching nothing"}}},
       {"jobs", jobs},
       {"quick", quick},
       {"position_error_max", "max over samples and points of |x - x_ref|"},
@@ -468,15 +382,16 @@ int main(int argc, char** argv) {
       {"energy_error_max", "max over samples of |E - E_ref| / E_ref(0)"},
       {"angular_momentum_error_max", "max over samples of |L - L_ref| / max |L_ref|"},
       {"wall_time", "the steps only (set-up apart), median of the repeats; first step inside"}};
-  sidecar["wall_time_s"] = since(started);
+  sidecar["wall_time_s"] = secondsSince(started);
   const std::filesystem::path dir = outDir;
-  if (!ranks.writeOutput("jello-work-precision", dir, name, table, sidecar,
-                         {{"damping", &damping}})) {
+  if (!ranks.writeOutput(
+          "jello-work-precision", dir, name, table, sidecar,
+          {{"damping", &damping}, {"drift", &driftSeries}, {"drift_summary", &driftSummary}})) {
     return 1;
   }
   if (!quiet && ranks.root()) {
-    std::printf("wrote %zu + %zu rows to %s (%.1f s)\n", table.rows(), damping.rows(), dir.c_str(),
-                sidecar["wall_time_s"].get<double>());
+    std::printf("wrote %zu + %zu + %zu rows to %s (%.1f s)\n", table.rows(), damping.rows(),
+                driftSeries.rows(), dir.c_str(), sidecar["wall_time_s"].get<double>());
   }
   return 0;
 }

@@ -1,0 +1,64 @@
+#include "tests/experiments_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "tests/test_support.h"
+
+namespace jello::experiments {
+
+Table readCsv(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::vector<std::string> columns;
+  Table rows;
+  const auto split = [](const std::string& s) {
+    std::vector<std::string> out;
+    std::stringstream ss(s);
+    for (std::string cell; std::getline(ss, cell, ',');) out.push_back(cell);
+    return out;
+  };
+  if (std::getline(in, line)) columns = split(line);
+  while (std::getline(in, line)) {
+    const auto cells = split(line);
+    std::map<std::string, std::string> row;
+    for (std::size_t i = 0; i < columns.size() && i < cells.size(); ++i) row[columns[i]] = cells[i];
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+int run(const std::string& command) {
+  return test::run(command + " --quiet").code;
+}
+
+double number(const std::map<std::string, std::string>& row, const std::string& column) {
+  return std::stod(row.at(column));
+}
+
+void expectSidecar(const std::filesystem::path& path, const char* program) {
+  std::ifstream in(path);
+  ASSERT_TRUE(in) << path;
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j.at("program"), program);
+  for (const char* key : {"command_line", "commit", "compiler", "blas", "machine", "parameters",
+                          "date_utc", "wall_time_s"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+}
+
+double slope(const std::vector<std::pair<double, double>>& points) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (auto [dt, e] : points) {
+    const double x = std::log(dt), y = std::log(e);
+    sx += x, sy += y, sxx += x * x, sxy += x * y;
+  }
+  const double n = double(points.size());
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+}  // namespace jello::experiments
