@@ -333,6 +333,21 @@ INSTANTIATE_TEST_SUITE_P(
             {"steps", "simulated_s", "wall_s", "wall_per_simulated_s", "assemble_per_simulated_s",
              "factor_per_simulated_s", "solve_per_simulated_s", "factorizations"}}),
     [](const ::testing::TestParamInfo<Distributed>& test) { return std::string(test.param.name); });
+
+// A bad argument under mpirun: one message (rank 0's), and every rank exits with the usage code.
+TEST(MpiUsage, ABadArgumentIsReportedOnceAndFailsTheJob) {
+  const test::Outcome o = test::run(
+      "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 PMIX_MCA_gds=hash " JELLO_MPIEXEC
+      " -np 2 --oversubscribe " +
+      std::string(JELLO_SCALING) + " --n 0");
+  EXPECT_NE(o.code, 0) << o.output;
+  std::size_t count = 0;
+  for (std::size_t at = o.output.find("--n"); at != std::string::npos;
+       at = o.output.find("--n", at + 1)) {
+    ++count;
+  }
+  EXPECT_EQ(count, 1u) << o.output;
+}
 #endif
 
 TEST(ExperimentPrograms, RefuseBadArguments) {

@@ -118,7 +118,8 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
     jello::refuseNonFiniteNumbers(app);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+    // Under mpirun every rank parses the same line: rank 0 alone prints, all exit alike.
+    return (ranks.root() ? app.exit(e) : e.get_exit_code()) == 0 ? 0 : 2;
   }
   // The tree as the run starts: the code that ran (outputs written later do not count).
   const nlohmann::json context = runContext(argc, argv);
