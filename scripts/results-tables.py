@@ -257,11 +257,25 @@ def scaling_summary():
     return "\n".join(lines)
 
 
+def experiments_runtime():
+    parts = []
+    for name in ("stability", "work_precision", "scaling"):
+        with open(os.path.join(RESULTS, name + ".json")) as f:
+            sidecar = json.load(f)
+        parts.append((name.replace("_", "-"), sidecar["wall_time_s"], sidecar["parameters"]["jobs"]))
+    total = sum(t for _, t, _ in parts)
+    each = ", ".join(f"jello-{n} {t / 60:.1f} min on {j} thread{'s' if j > 1 else ''}"
+                     for n, t, j in parts)
+    return (f"The committed results took {total / 60:.0f} minutes of wall time to make on 2-core "
+            f"VMs ({each}; each sidecar's `wall_time_s`, machine and date).")
+
+
 BLOCKS = {"stability-summary": stability_summary,
           "scaling-summary": scaling_summary,
           "work-precision-summary": work_precision_summary,
           "implicit-damping": implicit_damping,
-          "drift-summary": drift_summary}
+          "drift-summary": drift_summary,
+          "experiments-runtime": experiments_runtime}
 
 
 def render(text):

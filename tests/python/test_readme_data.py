@@ -63,7 +63,9 @@ def other_tables():
             "work-precision-summary":
                 load("scripts/results-tables.py").work_precision_summary(),
             "implicit-damping": load("scripts/results-tables.py").implicit_damping(),
-            "scaling-summary": load("scripts/results-tables.py").scaling_summary()}
+            "scaling-summary": load("scripts/results-tables.py").scaling_summary(),
+            "drift-summary": load("scripts/results-tables.py").drift_summary(),
+            "experiments-runtime": load("scripts/results-tables.py").experiments_runtime()}
 
 
 @pytest.mark.parametrize("tables", [speed_tables, integrator_tables, other_tables])
