@@ -257,6 +257,60 @@ def scaling_summary():
     return "\n".join(lines)
 
 
+def atlas_summary():
+    with open(os.path.join(RESULTS, "scaling_atlas.csv"), newline="") as f:
+        rows = list(csv.DictReader(f))
+    with open(os.path.join(RESULTS, "scaling.json")) as f:
+        sidecar = json.load(f)
+    atlas = sidecar["parameters"]["atlas"]
+    explicit = {"euler", "symplectic", "rk4"}
+    lines = [f"Visible motion within {100 * atlas['tolerance_m']:g} cm at the corners over "
+             f"{atlas['time_s']:g} s; commit {sidecar['commit'][:7]}, {sidecar['date_utc'][:10]}.",
+             ""]
+    pays = []
+    for n in sorted({int(r["n"]) for r in rows}):
+        lines += [f"**N = {n}** (wall time per simulated second; dt of the run in brackets)", "",
+                  "| k (N/m) | w_max (rad/s) | cheapest explicit | cheapest other | "
+                  "other vs explicit | not reached or over budget |",
+                  "|---|---|---|---|---|---|"]
+        for k in sorted({float(r["k_N_per_m"]) for r in rows if int(r["n"]) == n}):
+            here = [r for r in rows if int(r["n"]) == n and float(r["k_N_per_m"]) == k]
+            ok = [r for r in here if r["outcome"] == "ok"]
+
+            def best(group):
+                group = [r for r in ok if (r["integrator"] in explicit) == group]
+                return min(group, key=lambda r: float(r["wall_per_simulated_s"]), default=None)
+
+            def text(r):
+                if r is None:
+                    return "none"
+                step = (f"rtol {float(r['rtol']):.0e}" if r["integrator"] == "cvode"
+                        else f"dt {float(r['dt_s']):.3g}")
+                return f"{r['integrator']} {seconds(float(r['wall_per_simulated_s']))} ({step})"
+
+            e, o = best(True), best(False)
+            ratio = ""
+            if e and o:
+                x = float(e["wall_per_simulated_s"]) / float(o["wall_per_simulated_s"])
+                ratio = f"{x:.2g}x faster" if x >= 1 else f"{1 / x:.2g}x slower"
+                if x >= 1:
+                    pays.append((n, k, o["integrator"], x))
+            missing = ", ".join(sorted(r["integrator"] + ("" if r["outcome"] == "not_reached"
+                                                          else f" ({r['outcome']})")
+                                       for r in here if r["outcome"] != "ok"))
+            lines.append(f"| {k_text(k)} | {float(here[0]['w_max_rad_per_s']):,.0f} | {text(e)} | "
+                         f"{text(o)} | {ratio} | {missing} |")
+        lines.append("")
+    if pays:
+        lines.append("Where an implicit or adaptive method is cheapest: " + "; ".join(
+            f"N = {n}, k = {k_text(k)}: {name}, {x:.2g}x faster than the cheapest explicit method"
+            for n, k, name, x in pays) + ".")
+    else:
+        lines.append("At no point is an implicit or adaptive method cheaper than the cheapest "
+                     "explicit one.")
+    return "\n".join(lines)
+
+
 def experiments_runtime():
     parts = []
     for name in ("stability", "work_precision", "scaling"):
@@ -275,6 +329,7 @@ BLOCKS = {"stability-summary": stability_summary,
           "work-precision-summary": work_precision_summary,
           "implicit-damping": implicit_damping,
           "drift-summary": drift_summary,
+          "atlas-summary": atlas_summary,
           "experiments-runtime": experiments_runtime}
 
 

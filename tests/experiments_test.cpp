@@ -216,7 +216,8 @@ TEST(StabilityMapQuick, ThresholdsMeetTheirPredictionsAndImplicitNeverBlowsUp) {
 
 TEST(ScalingQuick, EveryIntegratorAndSizeHasItsCostAndTheImplicitSplit) {
   test::TempDir dir;
-  ASSERT_EQ(run(std::string(JELLO_SCALING) + " --quick --out-dir " + dir.path().string()), 0);
+  ASSERT_EQ(
+      run(std::string(JELLO_SCALING) + " --quick --no-atlas --out-dir " + dir.path().string()), 0);
   expectSidecar(dir.path() / "scaling.json", "jello-scaling");
   const Table rows = readCsv(dir.path() / "scaling.csv");
   EXPECT_EQ(rows.size(), 2u * 7u);  // N = 6, 8 x (3 explicit + implicit and cvode x 2 solvers)
@@ -228,6 +229,43 @@ TEST(ScalingQuick, EveryIntegratorAndSizeHasItsCostAndTheImplicitSplit) {
     if (r.at("integrator") == "implicit") {
       EXPECT_LE(number(r, "factor_per_simulated_s") + number(r, "solve_per_simulated_s"), cost);
     }
+  }
+}
+
+// The atlas's quick grid (N = 8, k = 1e3 and 1e5, 4 steps tried each): every cost is at a step
+// whose visible motion (the affine fit at the corners) is within 1 cm of a reference that is
+// itself ten times closer; RK4's cost grows with k (its limit falls as 1/sqrt(k)). Through the
+// bounce, backward Euler's artificial damping of the contact lowers the rebound beyond 1 cm at
+// every step tried, while midpoint (second order, no damping of its own) keeps the visible
+// motion at steps more than 20 times RK4's at k = 1e5.
+TEST(ScalingQuick, TheAtlasKeepsTheVisibleMotionAndBackwardEulerLosesTheBounce) {
+  test::TempDir dir;
+  ASSERT_EQ(run(std::string(JELLO_SCALING) + " --quick --n 6 --budget 0.05 --out-dir " +
+                dir.path().string()),
+            0);
+  const Table rows = readCsv(dir.path() / "scaling_atlas.csv");
+  ASSERT_EQ(rows.size(), 2u * 4u);
+  std::map<std::string, std::map<std::string, std::string>> point;
+  for (const auto& r : rows) {
+    EXPECT_EQ(r.at("n"), "8");
+    EXPECT_LT(number(r, "reference_check_m"), 1e-3);
+    EXPECT_LE(number(r, "reference_dt_s") * number(r, "w_max_rad_per_s"), 1.0 + 1e-12);
+    point[r.at("integrator") + "@" + r.at("k_N_per_m")] = r;
+    if (r.at("outcome") != "ok") continue;
+    EXPECT_LE(number(r, "visible_error_m"), 0.01) << r.at("integrator");
+    EXPECT_GT(number(r, "wall_per_simulated_s"), 0.0);
+  }
+  for (const char* key : {"rk4@1000", "rk4@100000", "symplectic@100000", "midpoint@100000"}) {
+    ASSERT_EQ(point.count(key), 1u) << key;
+    EXPECT_EQ(point[key].at("outcome"), "ok") << key;
+  }
+  EXPECT_GT(number(point["rk4@100000"], "wall_per_simulated_s"),
+            3.0 * number(point["rk4@1000"], "wall_per_simulated_s"));
+  EXPECT_GT(number(point["midpoint@100000"], "dt_s"), 20.0 * number(point["rk4@100000"], "dt_s"));
+  for (const char* key : {"implicit@1000", "implicit@100000"}) {
+    EXPECT_EQ(point[key].at("outcome"), "not_reached") << key;
+    EXPECT_GT(number(point[key], "visible_error_m"), 0.01) << key;
+    EXPECT_EQ(point[key].at("tried"), "4") << key;
   }
 }
 

@@ -1,4 +1,5 @@
-# Scaling from scaling.csv: wall time per simulated second against cube resolution N.
+# Scaling from scaling.csv: wall time per simulated second against cube resolution N; and the
+# crossover atlas from scaling_atlas.csv.
 # gnuplot -e "dir='experiments/results'" experiments/plots/scaling.gp
 if (!exists("dir")) dir = 'experiments/results'
 csv = dir.'/scaling.csv'
@@ -25,4 +26,28 @@ do for [fmt in "pngcairo svg"] {
        sel('cvode','cholmod') using 1:12 with linespoints pt 11 lw 2 lc rgb '#ff7f0e' title 'cvode, CHOLMOD', \
        sel('cvode','cg') using 1:12 with linespoints pt 13 lw 2 lc rgb '#e377c2' title 'cvode, CG'
   set output
+}
+
+# The crossover atlas from scaling_atlas.csv: each integrator's wall time per simulated second at
+# the largest step keeping the visible motion within the tolerance, against k, one chart per N.
+atlas = dir.'/scaling_atlas.csv'
+if (!exists("atlas_ns")) atlas_ns = '8 16'
+asel(n, integ) = sprintf("< awk -F, '$2==\"%s\" && $4==\"%s\" && $11==\"ok\"' %s | sort -t, -k1,1g", n, integ, atlas)
+aintegrators = "euler symplectic rk4 implicit implicit-linear midpoint newmark bdf2 projective cvode"
+acolors = "#d62728 #2ca02c #1f77b4 #9467bd #c5b0d5 #17becf #bcbd22 #e377c2 #7f7f7f #ff7f0e"
+apoints = "7 7 7 5 5 9 9 11 13 15"
+unset xtics
+set xtics auto
+set xrange [*:*]
+set format x '10^{%L}'
+set format y '10^{%L}'
+set xlabel 'spring stiffness k (N/m)'
+do for [n in atlas_ns] {
+  do for [fmt in "pngcairo svg"] {
+    if (fmt eq "pngcairo") { set terminal pngcairo size 900,560 font ",10"; set output dir.'/atlas_n'.n.'.png' } \
+    else { set terminal svg size 900,560 font ",10"; set output dir.'/atlas_n'.n.'.svg' }
+    set title 'Crossover atlas, N = '.n.': cost at the largest step keeping the visible motion within 1 cm (a missing point: not reached)'
+    plot for [i=1:10] asel(n, word(aintegrators,i)) using 1:8 with linespoints pt (word(apoints,i)+0) lw 2 lc rgb word(acolors,i) title word(aintegrators,i)
+    set output
+  }
 }

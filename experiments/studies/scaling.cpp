@@ -3,7 +3,10 @@
 // factorization and the solves split out. The scene is the stiff cube of work-precision
 // (k = 10^4 by default, stretched 5% and spinning) resampled to N^3 points: the mass per point
 // and the stiffness per spring stay, so w_max, and the explicit methods' stable step, stay too.
-//   jello-scaling [--quick] [--n LIST] [--budget S] [--out-dir DIR] [--jobs N]
+// Also the crossover atlas (atlas.h): over k and N, each integrator's cost at the largest step
+// that keeps the visible motion within a tolerance.
+//   jello-scaling [--quick] [--n LIST] [--budget S] [--atlas-k LIST] [--atlas-n LIST]
+//                 [--out-dir DIR] [--jobs N]
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
@@ -11,6 +14,7 @@
 #include <iostream>
 
 #include "experiments/common/signal_handler.h"
+#include "experiments/studies/atlas.h"
 #include "experiments/studies/csv_table.h"
 #include "experiments/studies/ranks.h"
 #include "experiments/studies/run_context.h"
@@ -75,7 +79,30 @@ int main(int argc, char** argv) {
                  "Largest N for cvode with CHOLMOD (one output interval there needs several "
                  "factorizations of minutes each at N = 32)")
       ->capture_default_str();
-  app.add_flag("--quick", quick, "CI: N = 6 and 8, 0.3 s per point");
+  // The whole atlas is hours of CPU at N = 32 (scripts/run-experiments.sh runs N = 8; a cluster
+  // runs the rest under mpirun).
+  std::vector<double> atlasK{1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8};
+  std::vector<int> atlasN{8, 16, 32};
+  AtlasSetup atlas;
+  app.add_option("--atlas-k", atlasK, "The atlas's stiffnesses, N/m (empty: no atlas)")
+      ->check(jello::cli::positive())
+      ->delimiter(',');
+  app.add_option("--atlas-n", atlasN, "The atlas's cube resolutions")
+      ->check(jello::cli::range(2, 64))
+      ->delimiter(',');
+  app.add_option("--atlas-tolerance", atlas.tolerance,
+                 "The atlas's accuracy on the visible motion, m at the corners")
+      ->check(jello::cli::positive())
+      ->capture_default_str();
+  app.add_option("--atlas-budget", atlas.runBudget,
+                 "Wall seconds of one atlas run beyond which smaller steps are not tried")
+      ->check(jello::cli::positive())
+      ->capture_default_str();
+  app.add_flag_function(
+      "--no-atlas", [&](std::int64_t) { atlasK.clear(); }, "Leave the atlas out");
+  app.add_flag("--quick", quick,
+               "CI: N = 6 and 8, 0.3 s per point; the atlas at k = 1e3 and 1e5, N = 8, with "
+               "symplectic, rk4, implicit and midpoint, 4 steps tried each");
   app.add_flag("--quiet", quiet, "No progress line");
   try {
     app.parse(argc, argv);
@@ -91,7 +118,19 @@ int main(int argc, char** argv) {
   if (quick) {
     if (app.count("--n") == 0) ns = {6, 8};
     if (app.count("--budget") == 0) budget = 0.3;
+    if (app.count("--atlas-k") == 0 && app.count("--no-atlas") == 0) atlasK = {1e3, 1e5};
+    if (app.count("--atlas-n") == 0) atlasN = {8};
+    atlas.halvings = 4;
   }
+  // The atlas's points, the costliest (largest N, then k) first; each computes its reference.
+  std::vector<std::pair<double, int>> atlasPoints;
+  for (int n : atlasN) {
+    for (double ak : atlasK) atlasPoints.emplace_back(ak, n);
+  }
+  std::stable_sort(atlasPoints.begin(), atlasPoints.end(), [](const auto& a, const auto& b) {
+    return a.second != b.second ? a.second > b.second : a.first > b.first;
+  });
+  CsvTable atlasRows = atlasTable();
 
   std::vector<Task> tasks;
   for (int n : ns) {
@@ -119,8 +158,17 @@ int main(int argc, char** argv) {
                   "solve_per_simulated_s", "factorizations"});
   const auto started = Clock::now();
   const bool ok = ranks.run(
-      "jello-scaling", int(tasks.size()), jobs, "points", !quiet,
+      "jello-scaling", int(tasks.size() + atlasPoints.size()), jobs, "points", !quiet,
       [&](int i) {
+        if (i >= int(tasks.size())) {
+          const auto [ak, an] = atlasPoints[static_cast<std::size_t>(i) - tasks.size()];
+          const World w = atlasScene(ak, an);
+          const AtlasReference reference = atlasReference(w, atlas);
+          for (IntegratorKind kind : atlasIntegrators(quick)) {
+            atlasPoint(w, ak, an, kind, reference, atlas, atlasRows);
+          }
+          return;
+        }
         const Task& t = tasks[static_cast<std::size_t>(i)];
         SceneSpec spec = vibratingStiffCube(k);
         spec.cubeResolution = t.n;
@@ -158,7 +206,7 @@ int main(int argc, char** argv) {
                        ? findStatistic(integ.statistics(), "factorizations").value_or(std::nan(""))
                        : std::nan("")});
       },
-      {&table});
+      {&table, &atlasRows});
   if (!ok) return 1;
   nlohmann::json sidecar = context;
   sidecar["program"] = "jello-scaling";
@@ -171,11 +219,37 @@ int main(int argc, char** argv) {
       {"cvode_rtol", rtol},
       {"cvode_cholmod_max_n", cvodeDirectMaxN},
       {"budget_s", budget},
+      {"atlas",
+       {{"k_N_per_m", atlasK},
+        {"n", atlasN},
+        {"scene",
+         "cube at rest shape thrown at 0.5 m/s and spinning 2 rad/s about z, falling 1.5 m onto "
+         "the floor under gravity, c = 0.25 N*s/m"},
+        {"time_s", atlas.time},
+        {"sample_interval_s", atlas.interval},
+        {"tolerance_m", atlas.tolerance},
+        {"visible_motion",
+         "the least-squares affine map of the rest lattice, compared at the 8 corners"},
+        {"reference", "rk4"},
+        {"reference_h_w_max", atlas.referenceHw},
+        {"run_budget_s", atlas.runBudget},
+        {"steps_tried", atlas.halvings},
+        {"explicit_start", "0.9 times the predicted limit"},
+        {"implicit_start_s", atlas.interval},
+        {"integrators",
+         [&] {
+           std::vector<std::string> names;
+           for (IntegratorKind kind : atlasIntegrators(quick))
+             names.emplace_back(integratorName(kind));
+           return names;
+         }()}}},
       {"jobs", jobs},
       {"quick", quick}};
   sidecar["wall_time_s"] = std::chrono::duration<double>(Clock::now() - started).count();
   const std::filesystem::path dir = outDir;
-  if (!ranks.writeOutput("jello-scaling", dir, name, table, sidecar)) return 1;
+  if (!ranks.writeOutput("jello-scaling", dir, name, table, sidecar, {{"atlas", &atlasRows}})) {
+    return 1;
+  }
   if (!quiet && ranks.root()) {
     std::printf("wrote %zu rows to %s (%.1f s)\n", table.rows(), (dir / (name + ".csv")).c_str(),
                 sidecar["wall_time_s"].get<double>());

@@ -65,6 +65,7 @@ def other_tables():
             "implicit-damping": load("scripts/results-tables.py").implicit_damping(),
             "scaling-summary": load("scripts/results-tables.py").scaling_summary(),
             "drift-summary": load("scripts/results-tables.py").drift_summary(),
+            "atlas-summary": load("scripts/results-tables.py").atlas_summary(),
             "experiments-runtime": load("scripts/results-tables.py").experiments_runtime()}
 
 

@@ -1,0 +1,225 @@
+#include "experiments/studies/atlas.h"
+
+#include <Eigen/Dense>
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include "experiments/studies/stability_analysis.h"
+#include "solvers/simulation.h"
+#include "src/lattice.h"
+#include "src/scene_builder.h"
+
+namespace jello::experiments {
+
+using Fit = Eigen::Matrix<double, 3, 4>;
+
+World atlasScene(double k, int n) {
+  SceneSpec spec = stiffCube(k);  // c = 0.25 N*s/m, no plane
+  spec.cubeResolution = n;
+  spec.pose = PosePreset::Rest;
+  spec.velocity = {0.5, 0.0, 0.0};
+  spec.spin = 2.0;
+  spec.field = FieldPreset::Gravity;
+  spec.fieldStrength = defaultFieldStrength(FieldPreset::Gravity, spec.mass);
+  spec.fieldResolution = 2;  // uniform
+  World w = buildWorld(spec);
+  // Centred above the floor (z = -2): 1.5 m of fall, the floor reached after about 0.55 s.
+  for (Vec3& p : w.positions) p += Vec3{-0.5, -0.5, -0.5};
+  return w;
+}
+
+VisibleMotion::VisibleMotion(int n) {
+  const Lattice lattice{n};
+  Eigen::Matrix3d gram = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      for (int k = 0; k < n; ++k) {
+        const Vec3 p = lattice.restPosition(i, j, k);
+        const Eigen::Vector3d r(p.x - 0.5, p.y - 0.5, p.z - 0.5);
+        rest_.push_back(r);
+        gram += r * r.transpose();
+      }
+    }
+  }
+  inverseGram_ = gram.inverse();
+}
+
+Fit VisibleMotion::fit(const State& s) const {
+  // rest_ is in the lattice's point order (Lattice::index).
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int p = 0; p < s.numPoints(); ++p) {
+    const Vec3 x = s.position(p);
+    mean += Eigen::Vector3d(x.x, x.y, x.z);
+  }
+  mean /= double(s.numPoints());
+  Eigen::Matrix3d cross = Eigen::Matrix3d::Zero();
+  for (int p = 0; p < s.numPoints(); ++p) {
+    const Vec3 x = s.position(p);
+    cross += (Eigen::Vector3d(x.x, x.y, x.z) - mean) * rest_[std::size_t(p)].transpose();
+  }
+  Fit f;
+  f.leftCols<3>() = cross * inverseGram_;
+  f.col(3) = mean;
+  return f;
+}
+
+double VisibleMotion::cornerDistance(const Fit& a, const Fit& b) const {
+  const Fit d = a - b;
+  double worst = 0.0;
+  for (int c = 0; c < 8; ++c) {
+    const Eigen::Vector3d corner(c & 1 ? 0.5 : -0.5, c & 2 ? 0.5 : -0.5, c & 4 ? 0.5 : -0.5);
+    worst = std::max(worst, (d.leftCols<3>() * corner + d.col(3)).norm());
+  }
+  return worst;
+}
+
+namespace {
+
+struct Attempt {
+  bool finished = false;  // false: diverged, failed or over the budget
+  std::string why;
+  double error = 0.0;  // m
+  double wallPerSecond = 0.0;
+  long steps = 0;
+};
+
+// `kind` at dt (cvode: the sample interval) over the window, the visible motion compared with
+// `reference` (none: the fits are returned in `fits`).
+Attempt attempt(const World& w, IntegratorKind kind, double dt, const SolverOptions& options,
+                const AtlasSetup& setup, const VisibleMotion& visible,
+                const AtlasReference* reference, std::vector<Fit>* fits = nullptr) {
+  using Clock = std::chrono::steady_clock;
+  Simulation sim(w, kind, dt, options);
+  const long perSample = std::max(1L, std::lround(setup.interval / dt));
+  const long samples = std::lround(setup.time / setup.interval);
+  if (fits) fits->push_back(visible.fit(sim.state()));
+  Attempt a;
+  double wall = 0.0;
+  for (long k = 1; k <= samples; ++k) {
+    const auto t0 = Clock::now();
+    for (long i = 0; i < perSample; ++i) {
+      const StepResult r = sim.step();
+      if (!r.ok) {
+        a.why = r.message;
+        return a;
+      }
+    }
+    wall += std::chrono::duration<double>(Clock::now() - t0).count();
+    if (wall > setup.runBudget) {
+      a.why = "over the run budget";
+      return a;
+    }
+    const Fit f = visible.fit(sim.state());
+    if (fits) fits->push_back(f);
+    if (reference) {
+      a.error = std::max(a.error, visible.cornerDistance(f, reference->samples[std::size_t(k)]));
+    }
+  }
+  a.finished = true;
+  a.wallPerSecond = wall / setup.time;
+  a.steps = sim.steps();
+  return a;
+}
+
+bool isExplicit(IntegratorKind kind) {
+  return kind == IntegratorKind::Euler || kind == IntegratorKind::Symplectic ||
+         kind == IntegratorKind::RK4;
+}
+
+}  // namespace
+
+AtlasReference atlasReference(const World& w, const AtlasSetup& setup) {
+  const double wMax = maxAngularFrequency(Model(w), initialState(w));
+  AtlasReference ref;
+  ref.dt =
+      setup.interval /
+      std::pow(2.0, std::max(0.0, std::ceil(std::log2(setup.interval * wMax / setup.referenceHw))));
+  const VisibleMotion visible(w.cubeResolution);
+  AtlasSetup unlimited = setup;
+  unlimited.runBudget = std::numeric_limits<double>::infinity();
+  const Attempt run =
+      attempt(w, IntegratorKind::RK4, ref.dt, {}, unlimited, visible, nullptr, &ref.samples);
+  if (!run.finished) throw std::runtime_error("atlas reference: " + run.why);
+  const Attempt check = attempt(w, IntegratorKind::RK4, 2 * ref.dt, {}, unlimited, visible, &ref);
+  if (!check.finished) throw std::runtime_error("atlas reference check: " + check.why);
+  ref.check = check.error;
+  return ref;
+}
+
+std::vector<IntegratorKind> atlasIntegrators(bool quick) {
+  if (quick) {
+    return {IntegratorKind::Symplectic, IntegratorKind::RK4, IntegratorKind::Implicit,
+            IntegratorKind::Midpoint};
+  }
+  return {IntegratorKind::Euler,    IntegratorKind::Symplectic,     IntegratorKind::RK4,
+          IntegratorKind::Implicit, IntegratorKind::ImplicitLinear, IntegratorKind::Midpoint,
+          IntegratorKind::Newmark,  IntegratorKind::Bdf2,           IntegratorKind::Projective,
+          IntegratorKind::Cvode};
+}
+
+CsvTable atlasTable() {
+  return CsvTable({"k_N_per_m", "n", "w_max_rad_per_s", "integrator", "dt_s", "rtol", "steps",
+                   "wall_per_simulated_s", "visible_error_m", "tried", "outcome", "reference_dt_s",
+                   "reference_check_m"});
+}
+
+void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const AtlasReference& ref,
+                const AtlasSetup& setup, CsvTable& table) {
+  const double wMax = maxAngularFrequency(Model(w), initialState(w));
+  const VisibleMotion visible(n);
+  const double nan = std::nan("");
+  // The candidates, largest first: explicit steps from 0.9 of the predicted limit (dividing the
+  // sample interval), the others from the interval; cvode's tolerances from 1e-2.
+  std::vector<double> steps, rtols;
+  if (kind == IntegratorKind::Cvode) {
+    for (int j = 0; j < setup.halvings; ++j) rtols.push_back(std::pow(10.0, -2 - j));
+  } else {
+    double dt = setup.interval;
+    if (isExplicit(kind)) {
+      const double limit = 0.9 * predictedThreshold(kind, wMax, w.dElastic / w.kElastic);
+      if (limit <= 0.0) {
+        table.add({k, long(n), wMax, std::string(integratorName(kind)), nan, nan, 0L, nan, nan, 0L,
+                   std::string("never_stable"), ref.dt, ref.check});
+        return;
+      }
+      dt = setup.interval / std::ceil(setup.interval / limit);
+    }
+    for (int j = 0; j < setup.halvings; ++j, dt /= 2.0) steps.push_back(dt);
+  }
+  const std::size_t count = kind == IntegratorKind::Cvode ? rtols.size() : steps.size();
+  long tried = 0;
+  double lastWall = 0.0, lastError = nan;
+  std::string outcome = "not_reached";
+  for (std::size_t i = 0; i < count; ++i) {
+    // Halving the step doubles the cost: a run that would exceed the budget is not started.
+    if (kind != IntegratorKind::Cvode && 2.0 * lastWall * setup.time > setup.runBudget) {
+      outcome = "budget";
+      break;
+    }
+    SolverOptions options;
+    double dt = kind == IntegratorKind::Cvode ? setup.interval : steps[i];
+    if (kind == IntegratorKind::Cvode) {
+      options.cvode.rtol = rtols[i];
+      options.cvode.maxStepsPerCall = 100000000;
+    }
+    const Attempt a = attempt(w, kind, dt, options, setup, visible, &ref);
+    ++tried;
+    if (!a.finished && a.why == "over the run budget") {
+      outcome = "budget";
+      break;
+    }
+    lastWall = a.wallPerSecond;
+    lastError = a.finished ? a.error : nan;
+    if (a.finished && a.error <= setup.tolerance) {
+      table.add({k, long(n), wMax, std::string(integratorName(kind)), dt,
+                 kind == IntegratorKind::Cvode ? rtols[i] : nan, a.steps, a.wallPerSecond, a.error,
+                 tried, std::string("ok"), ref.dt, ref.check});
+      return;
+    }
+  }
+  table.add({k, long(n), wMax, std::string(integratorName(kind)), nan, nan, 0L, nan, lastError,
+             tried, outcome, ref.dt, ref.check});
+}
+
+}  // namespace jello::experiments

@@ -1,0 +1,66 @@
+// The crossover atlas: for a spring stiffness k and a cube resolution N, each integrator's wall
+// time per simulated second at the largest step that keeps the visible motion within a
+// tolerance of a converged reference over the whole window, and stays stable. The scene is a
+// cube thrown sideways and spinning, falling under gravity onto the floor and bouncing (the
+// reference worlds' damping); its visible motion is what an affine map of the cube at rest
+// shows: the centre of mass, the rotation and the homogeneous stretch and shear, measured at
+// the cube's eight corners. Part of jello-scaling (its NAME_atlas.csv).
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "experiments/studies/csv_table.h"
+#include "solvers/integrator.h"
+#include "src/state.h"
+#include "src/world.h"
+
+namespace jello::experiments {
+
+struct AtlasSetup {
+  double time = 1.0;         // s, the window: the throw, the contact and the rebound
+  double interval = 0.02;    // s between samples, and the implicit methods' largest step
+  double tolerance = 0.01;   // m, at the corners (1% of the cube's edge)
+  double referenceHw = 1.0;  // h w_max of the reference's RK4 steps
+  double runBudget = 20.0;   // wall seconds: a run that would take longer ends the search
+  int halvings = 7;          // step sizes tried per integrator (explicit: below its limit)
+};
+
+// The scene at stiffness k (c = 0.25 N*s/m), N^3 points of 1/512 kg (w_max does not depend on N).
+World atlasScene(double k, int n);
+
+// Visible motion: the least-squares affine map x = A r + t of the rest lattice (r centred) onto
+// a state, and the largest distance between two such maps at the cube's corners.
+class VisibleMotion {
+ public:
+  explicit VisibleMotion(int n);
+  Eigen::Matrix<double, 3, 4> fit(const State& s) const;  // [A | t]
+  double cornerDistance(const Eigen::Matrix<double, 3, 4>& a,
+                        const Eigen::Matrix<double, 3, 4>& b) const;
+
+ private:
+  std::vector<Eigen::Vector3d> rest_;  // centred
+  Eigen::Matrix3d inverseGram_;
+};
+
+struct AtlasReference {
+  std::vector<Eigen::Matrix<double, 3, 4>> samples;  // the fit at t = k * interval
+  double dt = 0.0;                                   // s
+  double check = 0.0;  // m, the largest corner distance from RK4 at twice the reference's step
+};
+AtlasReference atlasReference(const World& w, const AtlasSetup& setup);
+
+// The integrators an atlas point compares (quick: symplectic, rk4, implicit, midpoint).
+std::vector<IntegratorKind> atlasIntegrators(bool quick);
+
+CsvTable atlasTable();
+// Searches `kind`'s largest step (cvode: loosest tolerance) within the tolerance on `w` and adds
+// the row: k, n, integrator, dt_s, rtol, steps (cvode: output intervals), wall_per_simulated_s,
+// visible_error_m (of the run kept, or of the last finished run), tried,
+// outcome ("ok", "not_reached": none of the steps tried was within the tolerance, "budget": the
+// next smaller step would have taken longer than the run budget).
+void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const AtlasReference& ref,
+                const AtlasSetup& setup, CsvTable& table);
+
+}  // namespace jello::experiments
