@@ -264,9 +264,11 @@ def atlas_summary():
         sidecar = json.load(f)
     atlas = sidecar["parameters"]["atlas"]
     explicit = {"euler", "symplectic", "rk4"}
+    checks = [float(r["reference_check_m"]) for r in rows]
     lines = [f"Visible motion within {100 * atlas['tolerance_m']:g} cm at the corners over "
-             f"{atlas['time_s']:g} s; commit {sidecar['commit'][:7]}, {sidecar['date_utc'][:10]}.",
-             ""]
+             f"{atlas['time_s']:g} s; the references within {1e3 * min(checks):.2g}-"
+             f"{1e3 * max(checks):.2g} mm of RK4 at twice their step; commit "
+             f"{sidecar['commit'][:7]}, {sidecar['date_utc'][:10]}.", ""]
     pays = []
     for n in sorted({int(r["n"]) for r in rows}):
         lines += [f"**N = {n}** (wall time per simulated second; dt of the run in brackets)", "",
