@@ -84,10 +84,11 @@ int main(int argc, char** argv) {
   std::vector<double> atlasK{1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8};
   std::vector<int> atlasN{8, 16, 32};
   AtlasSetup atlas;
-  app.add_option("--atlas-k", atlasK, "The atlas's stiffnesses, N/m (empty: no atlas)")
+  app.add_option("--atlas-k", atlasK,
+                 "The atlas's stiffnesses, N/m (default 1e2 to 1e8 by decades; --no-atlas: none)")
       ->check(jello::cli::positive())
       ->delimiter(',');
-  app.add_option("--atlas-n", atlasN, "The atlas's cube resolutions")
+  app.add_option("--atlas-n", atlasN, "The atlas's cube resolutions (default 8, 16, 32)")
       ->check(jello::cli::range(2, 64))
       ->delimiter(',');
   app.add_option("--atlas-tolerance", atlas.tolerance,
