@@ -28,6 +28,18 @@ README = os.path.join(ROOT, "README.md")
 ORDER = ["rk4", "symplectic", "euler", "implicit", "cvode"]
 
 
+def read_rows(name):
+    """The rows of experiments/results/NAME.csv, as dicts."""
+    with open(os.path.join(RESULTS, name + ".csv"), newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def read_sidecar(name):
+    """The JSON sidecar experiments/results/NAME.json."""
+    with open(os.path.join(RESULTS, name + ".json")) as f:
+        return json.load(f)
+
+
 def span(values, fmt="{:.2f}"):
     lo, hi = min(values), max(values)
     a, b = fmt.format(lo), fmt.format(hi)
@@ -40,10 +52,8 @@ def k_text(k):
 
 
 def stability_summary():
-    with open(os.path.join(RESULTS, "stability.csv"), newline="") as f:
-        rows = list(csv.DictReader(f))
-    with open(os.path.join(RESULTS, "stability.json")) as f:
-        sidecar = json.load(f)
+    rows = read_rows("stability")
+    sidecar = read_sidecar("stability")
     rule = sidecar["parameters"]["blow_up"]
     by = {}
     for r in rows:
@@ -104,10 +114,8 @@ def seconds(t):
 
 
 def work_precision_summary():
-    with open(os.path.join(RESULTS, "work_precision.csv"), newline="") as f:
-        rows = [r for r in csv.DictReader(f) if r["outcome"] == "ok"]
-    with open(os.path.join(RESULTS, "work_precision.json")) as f:
-        sidecar = json.load(f)
+    rows = [r for r in read_rows("work_precision") if r["outcome"] == "ok"]
+    sidecar = read_sidecar("work_precision")
     params = sidecar["parameters"]
     lines = [
         f"Errors sampled every {params['sample_interval_s']:g} s against the reference; wall "
@@ -161,11 +169,9 @@ def work_precision_summary():
 
 
 def implicit_damping():
-    with open(os.path.join(RESULTS, "work_precision_damping.csv"), newline="") as f:
-        rows = sorted((r for r in csv.DictReader(f) if r["integrator"] == "implicit"),
-                      key=lambda r: float(r["dt_s"]))
-    with open(os.path.join(RESULTS, "work_precision.json")) as f:
-        span_s = json.load(f)["parameters"]["damping_scene"]["time_s"]
+    rows = sorted((r for r in read_rows("work_precision_damping")
+                   if r["integrator"] == "implicit"), key=lambda r: float(r["dt_s"]))
+    span_s = read_sidecar("work_precision")["parameters"]["damping_scene"]["time_s"]
 
     def lost(r):
         return 100 * (1 - float(r["energy_end_J"]) / float(r["energy_start_J"]))
@@ -183,13 +189,11 @@ def implicit_damping():
 
 
 def drift_summary():
-    with open(os.path.join(RESULTS, "work_precision_drift_summary.csv"), newline="") as f:
-        rows = list(csv.DictReader(f))
-    with open(os.path.join(RESULTS, "work_precision.json")) as f:
-        sidecar = json.load(f)
-        scene = sidecar["parameters"]["drift_scene"]
-    lines = [f"Undamped cube, k = {scene['k_N_per_m']:g} N/m, {scene['time_s']:g} s, sampled every "
-             f"{scene['sample_interval_s']:g} s; commit {sidecar['commit'][:7]}, "
+    rows = read_rows("work_precision_drift_summary")
+    sidecar = read_sidecar("work_precision")
+    scene = sidecar["parameters"]["drift_scene"]
+    lines = [f"Undamped cube, k = {scene['k_N_per_m']:g} N/m, {scene['time_s']:g} s, sampled "
+             f"every {scene['sample_interval_s']:g} s; commit {sidecar['commit'][:7]}, "
              f"{sidecar['date_utc'][:10]}.", "",
              "| integrator | dt (s) | h w_max | E/E0 at the end | max \|E/E0 - 1\|, first half "
              "| same, second half | max \|L - L0\| / \|L0\| | wall time |",
@@ -210,10 +214,8 @@ def drift_summary():
 
 
 def scaling_summary():
-    with open(os.path.join(RESULTS, "scaling.csv"), newline="") as f:
-        rows = list(csv.DictReader(f))
-    with open(os.path.join(RESULTS, "scaling.json")) as f:
-        sidecar = json.load(f)
+    rows = read_rows("scaling")
+    sidecar = read_sidecar("scaling")
     cost = {(int(r["n"]), r["integrator"], r["linear_solver"]): r for r in rows}
     ns = sorted({int(r["n"]) for r in rows})
     columns = [("rk4", "none", "rk4"), ("symplectic", "none", "symplectic"),
@@ -258,10 +260,8 @@ def scaling_summary():
 
 
 def atlas_summary():
-    with open(os.path.join(RESULTS, "scaling_atlas.csv"), newline="") as f:
-        rows = list(csv.DictReader(f))
-    with open(os.path.join(RESULTS, "scaling.json")) as f:
-        sidecar = json.load(f)
+    rows = read_rows("scaling_atlas")
+    sidecar = read_sidecar("scaling")
     atlas = sidecar["parameters"]["atlas"]
     explicit = {"euler", "symplectic", "rk4"}
     checks = [float(r["reference_check_m"]) for r in rows]
@@ -316,9 +316,9 @@ def atlas_summary():
 def experiments_runtime():
     parts = []
     for name in ("stability", "work_precision", "scaling"):
-        with open(os.path.join(RESULTS, name + ".json")) as f:
-            sidecar = json.load(f)
-        parts.append((name.replace("_", "-"), sidecar["wall_time_s"], sidecar["parameters"]["jobs"]))
+        sidecar = read_sidecar(name)
+        parts.append((name.replace("_", "-"), sidecar["wall_time_s"],
+                      sidecar["parameters"]["jobs"]))
     total = sum(t for _, t, _ in parts)
     each = ", ".join(f"jello-{n} {t / 60:.1f} min on {j} thread{'s' if j > 1 else ''}"
                      for n, t, j in parts)

@@ -130,11 +130,12 @@ bool isExplicit(IntegratorKind kind) {
 }  // namespace
 
 AtlasReference atlasReference(const World& w, const AtlasSetup& setup) {
-  const double wMax = maxAngularFrequency(Model(w), initialState(w));
   AtlasReference ref;
+  ref.wMax = maxAngularFrequency(Model(w), initialState(w));
   ref.dt =
       setup.interval /
-      std::pow(2.0, std::max(0.0, std::ceil(std::log2(setup.interval * wMax / setup.referenceHw))));
+      std::pow(2.0,
+               std::max(0.0, std::ceil(std::log2(setup.interval * ref.wMax / setup.referenceHw))));
   const VisibleMotion visible(w.cubeResolution);
   AtlasSetup unlimited = setup;
   unlimited.runBudget = std::numeric_limits<double>::infinity();
@@ -166,7 +167,7 @@ CsvTable atlasTable() {
 
 void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const AtlasReference& ref,
                 const AtlasSetup& setup, CsvTable& table) {
-  const double wMax = maxAngularFrequency(Model(w), initialState(w));
+  const double wMax = ref.wMax;
   const VisibleMotion visible(n);
   const double nan = std::nan("");
   // The candidates, largest first: explicit steps from 0.9 of the predicted limit (dividing the

@@ -46,6 +46,7 @@ class VisibleMotion {
 
 struct AtlasReference {
   std::vector<Eigen::Matrix<double, 3, 4>> samples;  // the fit at t = k * interval
+  double wMax = 0.0;                                 // rad/s, of the scene at the start
   double dt = 0.0;                                   // s
   double check = 0.0;  // m, the largest corner distance from RK4 at twice the reference's step
 };

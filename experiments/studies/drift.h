@@ -24,7 +24,8 @@ struct DriftSetup {
 
 struct DriftRun {
   IntegratorKind kind;
-  double dt;  // s
+  double dt;     // s
+  double hwMax;  // dt times the scene's w_max at the start
 };
 
 // The scene: spinningStiffCube(k, 0) (stability_analysis.h).
