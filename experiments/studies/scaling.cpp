@@ -101,6 +101,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag_function(
       "--no-atlas", [&](std::int64_t) { atlasK.clear(); }, "Leave the atlas out");
+  bool noGrid = false;
+  app.add_flag("--no-grid", noGrid,
+               "Leave the resolution grid out: the atlas alone (NAME.csv holds only its header)");
   app.add_flag("--quick", quick,
                "CI: N = 6 and 8, 0.3 s per point; the atlas at k = 1e3 and 1e5, N = 8, with "
                "symplectic, rk4, implicit and midpoint, 4 steps tried each");
@@ -123,6 +126,7 @@ int main(int argc, char** argv) {
     if (app.count("--atlas-n") == 0) atlasN = {8};
     atlas.halvings = 4;
   }
+  if (noGrid) ns.clear();
   // The atlas's points, the costliest (largest N, then k) first; each computes its reference.
   std::vector<std::pair<double, int>> atlasPoints;
   for (int n : atlasN) {
