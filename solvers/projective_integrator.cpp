@@ -124,6 +124,11 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
   y_ = s.x + h * s.v;
   x_ = y_;
   int iterations = 0;
+  // Chebyshev: omega 1 while plain (ProjectiveOptions::chebyshevRho).
+  const double rho = options_.chebyshevRho;
+  const int delay = std::max(1, options_.chebyshevDelay);
+  double omega = 1.0, firstNorm = 0.0;
+  int plainSince = 0;  // the iteration the plain run (start or restart) began at
   for (; iterations < options_.iterations; ++iterations) {
     if (interruptRequested()) return StepResult::interruption();  // s is still the start
     // Local step inside the force evaluation; damping, field and user force at the iterate.
@@ -135,6 +140,8 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
     for (int c = 0; c < 3; ++c) changed = changed || weights_[c] != factoredWeights_[factorOf_[c]];
     changed = changed && factored_ && h == h_;
     if (changed) ++contactChanges_;
+    // A new contact set is a new iteration: Chebyshev's extrapolation starts again from plain.
+    const bool contactChanged = changed;
     if (!factored_ || h != h_ || changed) {
       if (StepResult res = factorChanged(h); !res.ok) return res;
     }
@@ -151,8 +158,41 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
     }
     if (!solved.ok) return solved;
     solveSeconds_ += secondsSince(start);
-    Eigen::Map<Eigen::MatrixXd>(x_.data(), n, 3) += delta_;
-    const double update = delta_.cwiseAbs().maxCoeff();
+    double update;
+    if (rho <= 0.0) {
+      Eigen::Map<Eigen::MatrixXd>(x_.data(), n, 3) += delta_;
+      update = delta_.cwiseAbs().maxCoeff();
+    } else {
+      const double norm = delta_.norm();
+      const int plain = iterations - plainSince;  // iterations since the plain run began
+      if (plain == 0) firstNorm = norm;
+      if (contactChanged && plain > 0) {
+        omega = 1.0;
+        plainSince = iterations;
+        firstNorm = norm;
+        ++chebyshevRestarts_;
+      } else if (omega != 1.0 && norm > firstNorm) {
+        // Growing beyond the run's first update (the contact set or the nonlinearity moved the
+        // spectrum past rho): this update is taken plain and the count starts again.
+        omega = 1.0;
+        plainSince = iterations;
+        firstNorm = norm;
+        ++chebyshevRestarts_;
+      } else if (plain == delay) {
+        omega = 2.0 / (2.0 - rho * rho);
+      } else if (plain > delay) {
+        omega = 4.0 / (4.0 - rho * rho * omega);
+      }
+      auto x = Eigen::Map<Eigen::MatrixXd>(x_.data(), n, 3);
+      if (omega != 1.0) {
+        // x_next = omega (x + delta - previous) + previous; delta becomes x_next - x.
+        const auto prev = Eigen::Map<const Eigen::MatrixXd>(previous_.data(), n, 3);
+        delta_ = omega * (x + delta_ - prev) + prev - x;
+      }
+      previous_ = x_;
+      x += delta_;
+      update = delta_.cwiseAbs().maxCoeff();
+    }
     lastUpdate_ = update;
     if (!std::isfinite(update)) return StepResult::failure("projective update is not finite");
     if (update <= options_.tolerance) {
@@ -178,6 +218,7 @@ std::vector<Statistic> ProjectiveIntegrator::statistics() const {
       {"contact_set_changes", static_cast<double>(contactChanges_)},
       {"factor_updates", static_cast<double>(updates_)},
       {"factor_time_s", factorSeconds_},
+      {"chebyshev_restarts", static_cast<double>(chebyshevRestarts_)},
       {"solve_time_s", solveSeconds_},
   };
 }

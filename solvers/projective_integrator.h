@@ -23,7 +23,8 @@
 // they are exactly where backward Euler evaluates them, so the iterations converge to the
 // `implicit` step, damping included (the lag converges because h c/(m + k h^2) << 1).
 // Options: iterations per step (10) and a tolerance (m): the iterations stop early when an
-// update moves no coordinate more than it (0: always all iterations).
+// update moves no coordinate more than it (0: always all iterations); Chebyshev acceleration
+// (ProjectiveOptions::chebyshevRho).
 #pragma once
 
 #include <Eigen/Core>
@@ -73,12 +74,13 @@ class ProjectiveIntegrator final : public Integrator {
   struct Factors;                           // CHOLMOD's, one per distinct matrix
   std::unique_ptr<Factors> factors_;
   bool factored_ = false;
-  Eigen::VectorXd y_, x_, v_, f_, r_;
-  Eigen::MatrixXd delta_;  // n x 3, the update of each coordinate
+  Eigen::VectorXd y_, x_, v_, f_, r_, previous_;  // previous_: the iterate before x_
+  Eigen::MatrixXd delta_;                         // n x 3, the update of each coordinate
   int lastIterations_ = 0;
   double lastUpdate_ = 0.0;
   std::vector<std::pair<int, double>> changes_;  // a coordinate's changed contact weights
   long steps_ = 0, iterations_ = 0, factorizations_ = 0, contactChanges_ = 0, updates_ = 0;
+  long chebyshevRestarts_ = 0;
   double factorSeconds_ = 0.0, solveSeconds_ = 0.0;
 };
 

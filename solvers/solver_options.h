@@ -88,6 +88,14 @@ struct ProjectiveOptions {
   // A contact change of a few points updates the factor (cholmod_updown); off: it always
   // refactors (the tests compare the two).
   bool updateFactors = true;
+  // Chebyshev semi-iterative acceleration (Wang 2015), on when chebyshevRho > 0: after
+  // `chebyshevDelay` plain iterations, x_{k+1} = w_{k+1} (x^_{k+1} - x_{k-1}) + x_{k-1}, x^ the
+  // plain iteration's result, w from w = 4 / (4 - rho^2 w) started at 2 / (2 - rho^2), rho the
+  // plain iterations' assumed contraction (a scene's constant, as in the paper: 0.85 measured
+  // best on the spinning stiff cube, README). An update larger than the run's first, or a change
+  // of the contact set, restarts it.
+  double chebyshevRho = 0.0;
+  int chebyshevDelay = 2;
 };
 
 struct SolverOptions {

@@ -159,6 +159,13 @@ TEST_P(HardCaseTest, ProjectiveStaysStable) {
   expectStableForTwoSeconds(GetParam(), IntegratorKind::Projective, {});
 }
 
+// Chebyshev's extrapolation must not undo the stability every plain iteration has.
+TEST_P(HardCaseTest, ProjectiveChebyshevStaysStable) {
+  SolverOptions o;
+  o.projective.chebyshevRho = 0.85;
+  expectStableForTwoSeconds(GetParam(), IntegratorKind::Projective, o);
+}
+
 TEST_P(HardCaseTest, CvodeStaysStable) {
   SolverOptions options;
   options.cvode.rtol = 1e-3;

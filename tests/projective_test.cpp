@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <map>
 #include <vector>
 
 #include "solvers/newton_integrators.h"
@@ -30,9 +31,11 @@ State backwardEulerStep(const Model& model, const State& start, double h) {
   return s;
 }
 
-State projectiveStep(const Model& model, const State& start, double h, int iterations) {
+State projectiveStep(const Model& model, const State& start, double h, int iterations,
+                     double chebyshevRho = 0.0) {
   ProjectiveOptions o;
   o.iterations = iterations;
+  o.chebyshevRho = chebyshevRho;
   ProjectiveIntegrator pd(o);
   State s = start;
   EXPECT_TRUE(pd.step(model, s, h).ok);
@@ -73,6 +76,51 @@ TEST(Projective, ConvergesToTheBackwardEulerStepAsIterationsGrow) {
     // iteration, slows the last digits: 4e-7).
     EXPECT_LE(previous, damping == 0.0 ? 1e-10 : 1e-6);
   }
+}
+
+// Chebyshev acceleration (Wang 2015, rho = 0.85) reaches the same step in fewer iterations:
+// measured on the spinning cube, 3.8x closer than the plain iterations at 10, 50x at 20, where
+// it is as close as 50 plain ones (within 3%); it converges as far.
+TEST(Projective, ChebyshevReachesTheBackwardEulerStepInFewerIterations) {
+  for (double k : {1e4, 1e5}) {
+    for (double damping : {0.0, 0.25}) {
+      SCOPED_TRACE("k " + std::to_string(k) + ", damping " + std::to_string(damping));
+      const World w = spinningCube(k, damping);
+      const Model model(w);
+      const State start = initialState(w);
+      const State be = backwardEulerStep(model, start, 0.01);
+      std::map<int, double> plain, fast;
+      for (int iterations : {10, 20, 50, 200}) {
+        plain[iterations] =
+            relativeStepError(start, be, projectiveStep(model, start, 0.01, iterations));
+        fast[iterations] =
+            relativeStepError(start, be, projectiveStep(model, start, 0.01, iterations, 0.85));
+        std::printf("k %g, damping %.2f, %3d iterations: plain %.3g, Chebyshev %.3g\n", k, damping,
+                    iterations, plain[iterations], fast[iterations]);
+      }
+      EXPECT_LT(fast[10], plain[10] / 2.0);
+      EXPECT_LT(fast[20], plain[20] / 10.0);
+      EXPECT_LT(fast[20], 1.1 * plain[50]);
+      EXPECT_LE(fast[200], damping == 0.0 ? 1e-10 : 1e-6);
+    }
+  }
+}
+
+// Through contact (the walls and the plane, contact damping): Chebyshev converges to the same
+// backward-Euler step.
+TEST(Projective, ChebyshevConvergesThroughContact) {
+  const World w = test::loadWorld("jello.w");
+  const Model model(w);
+  State start = initialState(w);
+  const int n = start.numPoints();
+  for (int p = 0; p < n; ++p) start.x[p] -= 0.35;
+  for (int p = 0; p < n; ++p) start.v[2 * n + p] -= 3.0;
+  const State be = backwardEulerStep(model, start, 0.01);
+  const double plain = relativeStepError(start, be, projectiveStep(model, start, 0.01, 30));
+  const double fast = relativeStepError(start, be, projectiveStep(model, start, 0.01, 30, 0.85));
+  std::printf("jello.w through a wall, 30 iterations: plain %.3g, Chebyshev %.3g\n", plain, fast);
+  EXPECT_LT(fast, plain);
+  EXPECT_LE(relativeStepError(start, be, projectiveStep(model, start, 0.01, 300, 0.85)), 1e-7);
 }
 
 TEST(Projective, ConvergesToTheBackwardEulerStepThroughContact) {

@@ -190,6 +190,7 @@ void Panel::solverOptions(const Frame& frame, SimRunner& runner) {
     options_ = frame.solverOptions;
     newtonTolerance_ = static_cast<float>(options_.implicit.newtonTolerance);
     rtol_ = static_cast<float>(options_.cvode.rtol);
+    chebyshevRho_ = static_cast<float>(options_.projective.chebyshevRho);
   }
   SolverOptions& o = options_;
   bool changed = false;
@@ -241,6 +242,9 @@ void Panel::solverOptions(const Frame& frame, SimRunner& runner) {
     }
     case IntegratorKind::Projective:
       ImGui::SliderInt("iterations", &o.projective.iterations, 1, 200);
+      changed |= released();
+      ImGui::SliderFloat("Chebyshev rho", &chebyshevRho_, 0.0f, 0.99f, "%.2f");
+      o.projective.chebyshevRho = chebyshevRho_;
       changed |= released();
       break;
     default:

@@ -72,7 +72,7 @@ class Panel {
   float dt_ = 0;
   float pullScale_ = 1;
   SolverOptions options_;  // the solver section's copy while editing
-  float newtonTolerance_ = 1e-8f, rtol_ = 1e-6f;
+  float newtonTolerance_ = 1e-8f, rtol_ = 1e-6f, chebyshevRho_ = 0.0f;
   std::optional<Plane> savedPlane_;
   std::optional<Sphere> savedSphere_;
   bool plane_ = false, sphere_ = false;

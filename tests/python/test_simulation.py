@@ -15,6 +15,7 @@ from conftest import program
     ("implicit", 0.01, 20, {}, []),
     ("bdf2", 0.005, 20, {"newton_tol": 1e-10}, ["--newton-tol", "1e-10"]),
     ("projective", 0.01, 10, {"projective_iters": 5}, ["--projective-iters", "5"]),
+    ("projective", 0.01, 10, {"projective_chebyshev": 0.85}, ["--projective-chebyshev", "0.85"]),
     ("cvode", 0.01, 5, {"rtol": 1e-4, "cvode_method": "adams"},
      ["--rtol", "1e-4", "--cvode-method", "adams"]),
 ])
@@ -150,6 +151,8 @@ def test_seeded_newton_takes_the_default_steps():
         jello.Simulation(world, integrator="implicit", preconditioner="nope")
     with pytest.raises(ValueError):
         jello.Simulation(world, integrator="implicit", newton_seed=-1)
+    with pytest.raises(ValueError, match="projective_chebyshev"):
+        jello.Simulation(world, integrator="projective", projective_chebyshev=1.0)
 
 
 def test_run_callback_every_and_stop(jello_w):

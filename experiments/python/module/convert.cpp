@@ -138,7 +138,8 @@ void translateExceptions(std::exception_ptr p) {
 constexpr const char* kSolverOptionNames =
     "linear_solver, preconditioner, matrix_free, clamp, cg_tol, newton_iters, newton_tol, "
     "newton_xtol, factor_reuse, newton_seed, "
-    "refactor_ratio, projective_iters, projective_tol, rtol, cvode_method, cvode_krylov, atol, "
+    "refactor_ratio, projective_iters, projective_tol, projective_chebyshev, rtol, cvode_method, "
+    "cvode_krylov, atol, "
     "atol_x, atol_v, contact_roots, max_order, stab_lim_det, max_step";
 
 bool boolOption(const py::handle& v, const std::string& name) {
@@ -187,6 +188,10 @@ jello::SolverOptions solverOptionsFrom(const py::kwargs& kwargs, jello::SolverOp
       o.projective.iterations = int(inRange(as<long>(value, name), 1, 100000, n));
     } else if (name == "projective_tol") {
       o.projective.tolerance = nonNegative(real(), n);
+    } else if (name == "projective_chebyshev") {
+      const double rho = nonNegative(real(), n);
+      if (rho >= 1.0) valueError("projective_chebyshev must be at least 0 and below 1");
+      o.projective.chebyshevRho = rho;
     } else if (name == "rtol") {
       o.cvode.rtol = positive(real(), n);
     } else if (name == "cvode_method") {
