@@ -419,7 +419,7 @@ int main(int argc, char** argv) {
                  "projective: Chebyshev acceleration of the iterations (Wang 2015) with this "
                  "assumed contraction rho, after 2 plain iterations (0: off; 0.85 measured best "
                  "on the spinning stiff cube)")
-      ->check(CLI::Range(0.0, 0.999))
+      ->check(jello::cli::range(0.0, 0.999))
       ->capture_default_str()
       ->group(implicitGroup);
   app.add_option("--rtol", cvode.rtol, "cvode: relative tolerance")
