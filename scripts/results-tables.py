@@ -259,29 +259,54 @@ def scaling_summary():
     return "\n".join(lines)
 
 
+def atlas_sources():
+    """Every committed atlas: (rows, sidecar) of scaling_atlas.csv (jello-scaling's full run) and
+    of each NAME_atlas.csv an atlas-only run wrote (NAME.json its sidecar), by N; an N in two
+    files is an error."""
+    names = sorted(f[:-len("_atlas.csv")] for f in os.listdir(RESULTS) if f.endswith("_atlas.csv"))
+    by_n = {}
+    for name in names:
+        sidecar = read_sidecar(name)
+        for r in read_rows(name + "_atlas"):
+            n = int(r["n"])
+            if n in by_n and by_n[n][1] is not sidecar:
+                raise SystemExit(f"results-tables: the atlas at N = {n} is in two files")
+            by_n.setdefault(n, ([], sidecar))[0].append(r)
+    return by_n
+
+
+ATLAS_EXPLICIT = {"euler", "symplectic", "rk4"}
+
+
+def atlas_cheapest(rows, explicit=None):
+    """The cheapest run within the tolerance among rows (explicit: only explicit methods, or
+    only the others; None: all)."""
+    ok = [r for r in rows if r["outcome"] == "ok" and
+          (explicit is None or (r["integrator"] in ATLAS_EXPLICIT) == explicit)]
+    return min(ok, key=lambda r: float(r["wall_per_simulated_s"]), default=None)
+
+
 def atlas_summary():
-    rows = read_rows("scaling_atlas")
-    sidecar = read_sidecar("scaling")
-    atlas = sidecar["parameters"]["atlas"]
-    explicit = {"euler", "symplectic", "rk4"}
-    checks = [float(r["reference_check_m"]) for r in rows]
-    lines = [f"Visible motion within {100 * atlas['tolerance_m']:g} cm at the corners over "
-             f"{atlas['time_s']:g} s; the references within {1e3 * min(checks):.2g}-"
-             f"{1e3 * max(checks):.2g} mm of RK4 at twice their step; commit "
-             f"{sidecar['commit'][:7]}, {sidecar['date_utc'][:10]}.", ""]
+    by_n = atlas_sources()
+    first = next(iter(by_n.values()))[1]["parameters"]["atlas"]
+    checks = [float(r["reference_check_m"]) for rows, _ in by_n.values() for r in rows]
+    lines = [f"Visible motion within {100 * first['tolerance_m']:g} cm at the corners over "
+             f"{first['time_s']:g} s; the references within {1e3 * min(checks):.2g}-"
+             f"{1e3 * max(checks):.2g} mm of RK4 at twice their step.", ""]
     pays = []
-    for n in sorted({int(r["n"]) for r in rows}):
-        lines += [f"**N = {n}** (wall time per simulated second; dt of the run in brackets)", "",
+    for n in sorted(by_n):
+        rows, sidecar = by_n[n]
+        atlas = sidecar["parameters"]["atlas"]
+        lines += [f"**N = {n}** (wall time per simulated second; dt of the run in brackets; "
+                  f"budget {atlas['run_budget_s']:g} s a run; commit {sidecar['commit'][:7]}"
+                  f"{' (modified tree)' if sidecar.get('tree_modified') else ''}, "
+                  f"{sidecar['date_utc'][:10]}, {sidecar['wall_time_s'] / 60:.0f} min"
+                  f"{' with the resolution grid' if sidecar['parameters']['n'] else ''})", "",
                   "| k (N/m) | w_max (rad/s) | cheapest explicit | cheapest other | "
                   "other vs explicit | not reached or over budget |",
                   "|---|---|---|---|---|---|"]
-        for k in sorted({float(r["k_N_per_m"]) for r in rows if int(r["n"]) == n}):
-            here = [r for r in rows if int(r["n"]) == n and float(r["k_N_per_m"]) == k]
-            ok = [r for r in here if r["outcome"] == "ok"]
-
-            def best(group):
-                group = [r for r in ok if (r["integrator"] in explicit) == group]
-                return min(group, key=lambda r: float(r["wall_per_simulated_s"]), default=None)
+        for k in sorted({float(r["k_N_per_m"]) for r in rows}):
+            here = [r for r in rows if float(r["k_N_per_m"]) == k]
 
             def text(r):
                 if r is None:
@@ -290,7 +315,7 @@ def atlas_summary():
                         else f"dt {float(r['dt_s']):.3g}")
                 return f"{r['integrator']} {seconds(float(r['wall_per_simulated_s']))} ({step})"
 
-            e, o = best(True), best(False)
+            e, o = atlas_cheapest(here, True), atlas_cheapest(here, False)
             ratio = ""
             if e and o:
                 x = float(e["wall_per_simulated_s"]) / float(o["wall_per_simulated_s"])
@@ -313,6 +338,30 @@ def atlas_summary():
     return "\n".join(lines)
 
 
+def atlas_region():
+    """The cheapest method at each (k, N) of the atlas, with its cost; a blank: not run."""
+    by_n = atlas_sources()
+    ns = sorted(by_n)
+    ks = sorted({float(r["k_N_per_m"]) for rows, _ in by_n.values() for r in rows})
+    lines = ["| k (N/m) | " + " | ".join(f"N = {n}" for n in ns) + " |",
+             "|---|" + "---|" * len(ns)]
+    for k in ks:
+        cells = []
+        for n in ns:
+            here = [r for r in by_n[n][0] if float(r["k_N_per_m"]) == k]
+            best = atlas_cheapest(here)
+            if not here:
+                cells.append("not run")
+            elif best is None:
+                budget = by_n[n][1]["parameters"]["atlas"]["run_budget_s"]
+                cells.append(f"none within {budget:g} s")
+            else:
+                cells.append(f"{best['integrator']} "
+                             f"{seconds(float(best['wall_per_simulated_s']))}")
+        lines.append(f"| {k_text(k)} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def experiments_runtime():
     parts = []
     for name in ("stability", "work_precision", "scaling"):
@@ -322,8 +371,17 @@ def experiments_runtime():
     total = sum(t for _, t, _ in parts)
     each = ", ".join(f"jello-{n} {t / 60:.1f} min on {j} thread{'s' if j > 1 else ''}"
                      for n, t, j in parts)
-    return (f"The committed results took {total / 60:.0f} minutes of wall time to make on 2-core "
+    text = (f"The committed results took {total / 60:.0f} minutes of wall time to make on 2-core "
             f"VMs ({each}; each sidecar's `wall_time_s`, machine and date).")
+    # The atlas-only runs (scripts/run-experiments.sh atlas): one per N, side by side.
+    extra = sorted((int(rows[0]["n"]), sidecar["wall_time_s"])
+                   for rows, sidecar in atlas_sources().values()
+                   if not sidecar["parameters"]["n"])
+    if extra:
+        text += (" The atlas at " + " and ".join(f"N = {n}" for n, _ in extra) + " took " +
+                 " and ".join(f"{t / 60:.0f} min" for _, t in extra) +
+                 ", each on one core of the same machine, side by side.")
+    return text
 
 
 BLOCKS = {"stability-summary": stability_summary,
@@ -332,6 +390,7 @@ BLOCKS = {"stability-summary": stability_summary,
           "implicit-damping": implicit_damping,
           "drift-summary": drift_summary,
           "atlas-summary": atlas_summary,
+          "atlas-region": atlas_region,
           "experiments-runtime": experiments_runtime}
 
 
