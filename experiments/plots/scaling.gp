@@ -59,7 +59,7 @@ acolor(s) = s eq 'euler' ? 0xd62728 : s eq 'symplectic' ? 0x2ca02c : s eq 'rk4' 
   s eq 'implicit' ? 0x9467bd : s eq 'implicit-linear' ? 0xc5b0d5 : s eq 'midpoint' ? 0x17becf : \
   s eq 'newmark' ? 0xbcbd22 : s eq 'bdf2' ? 0xe377c2 : s eq 'projective' ? 0x7f7f7f : \
   s eq 'cvode' ? 0xff7f0e : 0xdddddd
-cost(t) = t != t ? 'within no budget' : t < 1 ? sprintf('%.3g ms', 1e3 * t) : sprintf('%.3g s', t)
+cost(t) = t < 1 ? sprintf('%.3g ms', 1e3 * t) : sprintf('%.3g s', t)
 set datafile separator whitespace
 set logscale x
 set logscale y 2
@@ -74,7 +74,7 @@ do for [fmt in "pngcairo svg"] {
   else { set terminal svg size 1000,420 font ",10"; set output dir.'/atlas_region.svg' }
   set title 'Crossover atlas: the cheapest integrator keeping the visible motion within 1 cm, and its wall time per simulated second'
   plot region using 1:2:(acolor(strcol(3))) with points pt 5 ps 7 lc rgb variable notitle, \
-       region using 1:2:(strcol(3)."\n".cost($4)) with labels font ",8" notitle, \
+       region using 1:2:(strcol(3) eq 'none' ? "none within\nthe budget" : strcol(3)."\n".cost(column(4))) with labels font ",8" notitle, \
        for [i=1:10] NaN with points pt 5 ps 2 lc rgb word(acolors,i) title word(aintegrators,i)
   set output
 }
