@@ -66,6 +66,7 @@ def other_tables():
             "scaling-summary": load("scripts/results-tables.py").scaling_summary(),
             "drift-summary": load("scripts/results-tables.py").drift_summary(),
             "atlas-summary": load("scripts/results-tables.py").atlas_summary(),
+            "atlas-region": load("scripts/results-tables.py").atlas_region(),
             "experiments-runtime": load("scripts/results-tables.py").experiments_runtime()}
 
 
