@@ -140,8 +140,7 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
     for (int c = 0; c < 3; ++c) changed = changed || weights_[c] != factoredWeights_[factorOf_[c]];
     changed = changed && factored_ && h == h_;
     if (changed) ++contactChanges_;
-    // A new contact set is a new iteration: Chebyshev's extrapolation starts again from plain.
-    const bool contactChanged = changed;
+    const bool contactChanged = changed;  // Chebyshev starts again from plain
     if (!factored_ || h != h_ || changed) {
       if (StepResult res = factorChanged(h); !res.ok) return res;
     }
@@ -166,14 +165,10 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
       const double norm = delta_.norm();
       const int plain = iterations - plainSince;  // iterations since the plain run began
       if (plain == 0) firstNorm = norm;
-      if (contactChanged && plain > 0) {
-        omega = 1.0;
-        plainSince = iterations;
-        firstNorm = norm;
-        ++chebyshevRestarts_;
-      } else if (omega != 1.0 && norm > firstNorm) {
-        // Growing beyond the run's first update (the contact set or the nonlinearity moved the
-        // spectrum past rho): this update is taken plain and the count starts again.
+      if ((contactChanged && plain > 0) || (omega != 1.0 && norm > firstNorm)) {
+        // A new contact set (a new iteration matrix), or an update grown beyond the run's first
+        // (the nonlinearity moved the spectrum past rho): this update is taken plain and the
+        // count starts again.
         omega = 1.0;
         plainSince = iterations;
         firstNorm = norm;
