@@ -39,7 +39,11 @@ State projectiveStep(const Model& model, const State& start, double h, int itera
   ProjectiveIntegrator pd(o);
   State s = start;
   EXPECT_TRUE(pd.step(model, s, h).ok);
-  EXPECT_EQ(pd.lastIterations(), iterations);
+  // Every iteration is done, unless one reached the fixed point exactly (an update of 0 stops
+  // them at the default tolerance 0: Chebyshev through contact did at 75 of 300 under ASan).
+  EXPECT_TRUE(pd.lastIterations() == iterations || pd.lastUpdate() == 0.0)
+      << pd.lastIterations() << " of " << iterations << " iterations, the last moving "
+      << pd.lastUpdate() << " m";
   return s;
 }
 
