@@ -15,6 +15,7 @@ nothing and exits 1 when README.md differs from what the data gives (ctest runs 
 """
 import argparse
 import csv
+import functools
 import json
 import os
 import sys
@@ -259,10 +260,11 @@ def scaling_summary():
     return "\n".join(lines)
 
 
+@functools.lru_cache(maxsize=None)
 def atlas_sources():
     """Every committed atlas: (rows, sidecar) of scaling_atlas.csv (jello-scaling's full run) and
     of each NAME_atlas.csv an atlas-only run wrote (NAME.json its sidecar), by N; an N in two
-    files is an error."""
+    files is an error. Read once (three blocks use it); not to be modified."""
     names = sorted(f[:-len("_atlas.csv")] for f in os.listdir(RESULTS) if f.endswith("_atlas.csv"))
     by_n = {}
     for name in names:

@@ -30,6 +30,12 @@ if [ "$out" = experiments/results ] && [ -z "${JELLO_ALLOW_DIRTY:-}" ] &&
   exit 1
 fi
 mkdir -p "$out"
+# The atlas's charts cover every N committed (the atlas-only runs' files included).
+draw_atlas() {
+  local ns
+  ns=$(awk -F, 'FNR > 1 { print $2 }' "$out"/*_atlas.csv | sort -nu | tr '\n' ' ')
+  gnuplot -e "dir='$out'; atlas_ns='$ns'" experiments/plots/scaling.gp
+}
 if [ "${1:-}" = atlas ]; then
   export OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1
   # A run of 60 s is allowed (20 at N = 8): at N = 16 and 32 a converged implicit second costs
@@ -40,7 +46,7 @@ if [ "${1:-}" = atlas ]; then
   taskset -c 1 "$bin/jello-scaling" "${common[@]}" --atlas-n 32 \
     --atlas-k 1e2,1e3,1e4,1e5,1e6 --name atlas32 --quiet
   wait "$first"
-  gnuplot -e "dir='$out'; atlas_ns='8 16 32'" experiments/plots/scaling.gp
+  draw_atlas
   echo "run-experiments: the atlas at N = 16 and 32 in $out/"
   exit 0
 fi
@@ -54,7 +60,5 @@ atlas_n=(--atlas-n 8)
 "$bin/jello-scaling" "${args[@]}" "${atlas_n[@]}" --jobs 1 --out-dir "$out"
 gnuplot -e "dir='$out'; scenes='$stability_scenes'" experiments/plots/stability.gp
 gnuplot -e "dir='$out'; scenes='$precision_scenes'" experiments/plots/work_precision.gp
-# The atlas's charts cover every N committed (the atlas-only runs' files included).
-atlas_ns=$(awk -F, 'FNR > 1 { print $2 }' "$out"/*_atlas.csv | sort -nu | tr '\n' ' ')
-gnuplot -e "dir='$out'; atlas_ns='$atlas_ns'" experiments/plots/scaling.gp
+draw_atlas
 echo "run-experiments: results and charts in $out/"
