@@ -58,6 +58,16 @@ World spinningCube(double k, double damping) {
   return buildWorld(spec);
 }
 
+// jello.w's deformed cube shifted so some points are through the x = -2 wall, and thrown down
+// (toward the plane): contact, contact damping and spring damping in one step.
+State throughAWall(const World& w) {
+  State start = initialState(w);
+  const int n = start.numPoints();
+  for (int p = 0; p < n; ++p) start.x[p] -= 0.35;
+  for (int p = 0; p < n; ++p) start.v[2 * n + p] -= 3.0;
+  return start;
+}
+
 TEST(Projective, ConvergesToTheBackwardEulerStepAsIterationsGrow) {
   for (double damping : {0.0, 0.25}) {
     SCOPED_TRACE("damping " + std::to_string(damping));
@@ -115,10 +125,7 @@ TEST(Projective, ChebyshevReachesTheBackwardEulerStepInFewerIterations) {
 TEST(Projective, ChebyshevConvergesThroughContact) {
   const World w = test::loadWorld("jello.w");
   const Model model(w);
-  State start = initialState(w);
-  const int n = start.numPoints();
-  for (int p = 0; p < n; ++p) start.x[p] -= 0.35;
-  for (int p = 0; p < n; ++p) start.v[2 * n + p] -= 3.0;
+  const State start = throughAWall(w);
   const State be = backwardEulerStep(model, start, 0.01);
   const double plain = relativeStepError(start, be, projectiveStep(model, start, 0.01, 30));
   const double fast = relativeStepError(start, be, projectiveStep(model, start, 0.01, 30, 0.85));
@@ -132,10 +139,7 @@ TEST(Projective, ConvergesToTheBackwardEulerStepThroughContact) {
   // the fixed point is backward Euler's with every effect where it evaluates them.
   const World w = test::loadWorld("jello.w");
   const Model model(w);
-  State start = initialState(w);
-  const int n = start.numPoints();
-  for (int p = 0; p < n; ++p) start.x[p] -= 0.35;  // some points through the x = -2 wall
-  for (int p = 0; p < n; ++p) start.v[2 * n + p] -= 3.0;
+  const State start = throughAWall(w);
   const State be = backwardEulerStep(model, start, 0.01);
   const double e = relativeStepError(start, be, projectiveStep(model, start, 0.01, 300));
   EXPECT_LE(e, 1e-7);
