@@ -150,17 +150,26 @@ TEST(Projective, KeepsTheAngularMomentumLikeBackwardEuler) {
   for (double k : {1e4, 1e5}) {
     SCOPED_TRACE("k " + std::to_string(k));
     const World w = spinningCube(k, 0.0);
-    double kept[2];
-    int i = 0;
-    for (IntegratorKind kind : {IntegratorKind::Implicit, IntegratorKind::Projective}) {
-      Simulation sim(w, kind, 0.01);
+    // implicit, projective, projective with Chebyshev (rho 0.85).
+    double kept[3], energy[3];
+    for (int i = 0; i < 3; ++i) {
+      SolverOptions o;
+      if (i == 2) o.projective.chebyshevRho = 0.85;
+      Simulation sim(w, i == 0 ? IntegratorKind::Implicit : IntegratorKind::Projective, 0.01, o);
       const Eigen::Vector3d L0 = angularMomentum(sim.model(), sim.state());
+      const double e0 = sim.model().energy(sim.state()).total();
       for (int step = 0; step < 20; ++step) ASSERT_TRUE(sim.step().ok);
-      kept[i++] = angularMomentum(sim.model(), sim.state()).dot(L0) / L0.squaredNorm();
+      kept[i] = angularMomentum(sim.model(), sim.state()).dot(L0) / L0.squaredNorm();
+      energy[i] = sim.model().energy(sim.state()).total() / e0;
     }
-    std::printf("k = %g: implicit keeps %.4f of the angular momentum, projective %.4f\n", k,
-                kept[0], kept[1]);
+    std::printf(
+        "k = %g: implicit keeps %.4f of the angular momentum and %.4g of the energy, "
+        "projective %.4f and %.4g, with Chebyshev %.4f and %.4g\n",
+        k, kept[0], energy[0], kept[1], energy[1], kept[2], energy[2]);
     EXPECT_NEAR(kept[1], kept[0], 0.01);
+    // Chebyshev converges to the same step: the same angular momentum and energy as implicit.
+    EXPECT_NEAR(kept[2], kept[0], 0.01);
+    EXPECT_NEAR(energy[2], energy[0], 0.05 * energy[0] + 1e-6);
   }
 }
 
