@@ -1,13 +1,21 @@
 // A Cholesky factor for many cheap solves with up to three right-hand sides: the matrices whose
 // factor is kept for hundreds of solves (projective's M/h^2 + L, the projective preconditioner
-// of CG). CHOLMOD factors (supernodal, its own fill-reducing ordering); the factor is then copied
-// into two plain arrays, L by rows and by columns, and the solves run over them with the three
-// right-hand sides side by side in one 4-wide vector per point and four independent
-// accumulators per row, so every entry of L is read once per triangle for all three columns and
-// no chain of dependent additions limits the loop. Measured at 8^3 (512 points, 42,000 entries
-// in L): a solve for three columns takes about half of CHOLMOD's own supernodal solve. A factor
-// too large for the copy to stay in cache (above 400,000 entries: 12^3 points and more) is
-// solved by CHOLMOD itself. Solves allocate nothing after the first.
+// of CG). CHOLMOD factors (supernodal, its own fill-reducing ordering); the solves then run over
+// a copy of the factor, in one of two forms by its size:
+// - up to copyLimit entries, L by rows and by columns in two plain arrays, the three
+//   right-hand sides side by side in one 4-wide vector per point and four independent
+//   accumulators per row, so every entry of L is read once per triangle for all three columns
+//   and no chain of dependent additions limits the loop. Measured at 8^3 (512 points, 42,000
+//   entries in L): a solve for three columns takes about half of CHOLMOD's own supernodal solve.
+// - above (12^3 points and more: the copy and its indices no longer stay in cache), CHOLMOD's
+//   dense supernodes copied in single precision and solved by our own blocked substitutions,
+//   every product and sum in double: these solves are bound by memory traffic, which the floats
+//   halve (BM_KeptFactorSolve: 1.7x faster than CHOLMOD's double solve at 16^3 and 32^3). The
+//   answer is that of a factor rounded to single precision (about 1e-7 relative times the
+//   condition number): what a preconditioner or projective's fixed-point iterations need, whose
+//   residuals are evaluated in double. singlePrecision = false solves these by CHOLMOD.
+// After addToDiagonal (CHOLMOD's updates of a simplicial copy), large factors are solved by
+// CHOLMOD until the next factorize. Solves allocate nothing after the first.
 #pragma once
 
 #include <memory>
@@ -17,13 +25,17 @@
 #include "solvers/jacobian.h"
 #include "solvers/step_result.h"
 
+struct cholmod_factor_struct;  // CHOLMOD's cholmod_factor
+
 namespace jello {
 
 class PrefactoredCholesky {
  public:
   // Factors with more entries than copyLimit are solved by CHOLMOD (the default: measured).
   static constexpr long kDefaultCopyLimit = 400000;
-  explicit PrefactoredCholesky(long copyLimit = kDefaultCopyLimit);
+  // singlePrecision: larger factors are solved over a single-precision copy of CHOLMOD's
+  // supernodes (every operation in double) instead of by CHOLMOD itself.
+  explicit PrefactoredCholesky(long copyLimit = kDefaultCopyLimit, bool singlePrecision = true);
   ~PrefactoredCholesky();
   PrefactoredCholesky(const PrefactoredCholesky&) = delete;
   PrefactoredCholesky& operator=(const PrefactoredCholesky&) = delete;
@@ -52,6 +64,8 @@ class PrefactoredCholesky {
   struct Impl;  // CHOLMOD's common and symbolic factor, the solves' work vectors
   std::unique_ptr<Impl> impl_;
   long copyLimit_;
+  bool singlePrecision_;
+  void copySupernodes(const cholmod_factor_struct& L);  // the single-precision copy
   StepResult solveByCholmod(double* b, int columns) const;
   void transposeCopy();  // L by rows from L by columns
   int n_ = 0;

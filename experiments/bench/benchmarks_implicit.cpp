@@ -8,13 +8,15 @@
 //                               statistics)
 //   BM_StiffOneSecond/<method>/E  stiffCube(10^E) for 1 simulated second: implicit at
 //                               dt = 0.01 against RK4 at its largest stable dt (bisection)
-//   BM_ImplicitIntegratorStep/<integrator>/N/spinning  one step at dt = 0.01 (projective: 10
-//                               iterations; also at N = 32 on jello.w; the defaults solve by CG
+//   BM_ImplicitIntegratorStep/<integrator>/N/spinning  one step at dt = 0.01 after a first
+//                               step timed apart (counter first_step_ms: set-up); projective: 10
+//                               iterations, also at N = 32; the defaults solve by CG
 //                               with Jacobi; implicit_cholmod: by CHOLMOD; implicit_fast:
 //                               fastNewton() below)
-//   BM_KeptFactorSolve/<copy|cholmod>/N  three right-hand sides solved with projective's kept
-//                               factor M/h^2 + L at N^3 (h = 0.01): our own substitutions over
-//                               the copied factor, or CHOLMOD's cholmod_solve2 (counter nnz_L)
+//   BM_KeptFactorSolve/<copy|single|cholmod>/N  three right-hand sides solved with projective's
+//                               kept factor M/h^2 + L at N^3 (h = 0.01): our own substitutions
+//                               over the copied factor or over its supernodes in single
+//                               precision, or CHOLMOD's cholmod_solve2 (counter nnz_L)
 //   BM_Crossover/<method>/E     1 simulated second of the spinning stretched cube at k = 10^E
 //                               with damping 0.25 (8^3): projective at dt = 1/60, implicit and
 //                               bdf2 at dt = 0.01 (also in fastNewton's configuration), RK4 at
@@ -22,6 +24,7 @@
 //                               the time is wall time per simulated second
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 
@@ -200,6 +203,11 @@ void BM_ImplicitIntegratorStep(benchmark::State& st, IntegratorKind kind,
   spinning.dElastic = 0.0;
   const World w = st.range(1) == 0 ? jelloAt(n) : resampleCube(buildWorld(spinning), n);
   Simulation sim(w, kind, 0.01, options);
+  // The first step (a factor's analysis, the first factorization) is set-up: timed apart.
+  const auto start = std::chrono::steady_clock::now();
+  if (!sim.step().ok) st.SkipWithError("first step failed");
+  st.counters["first_step_ms"] =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   for (auto _ : st) {
     if (!sim.step().ok) st.SkipWithError("step failed");
   }
@@ -226,33 +234,50 @@ JELLO_IMPLICIT_STEP_BENCHMARK(newmark, IntegratorKind::Newmark);
 JELLO_IMPLICIT_STEP_BENCHMARK(bdf2, IntegratorKind::Bdf2);
 JELLO_IMPLICIT_STEP_BENCHMARK(projective, IntegratorKind::Projective);
 BENCHMARK_CAPTURE(BM_ImplicitIntegratorStep, projective, IntegratorKind::Projective)
-    ->Args({32, 0})
+    ->ArgsProduct({{32}, {0, 1}})
     ->ArgNames({"N", "spinning"})
     ->Unit(benchmark::kMillisecond);
 
-void BM_KeptFactorSolve(benchmark::State& st, bool copy) {
+enum class KeptFactorWay { Copy, Single, Cholmod };
+
+void BM_KeptFactorSolve(benchmark::State& st, KeptFactorWay way) {
   const Model model(jelloAt(static_cast<int>(st.range(0))));
   const SpringLaplacian laplacian(model);
   SparseMatrix A;
   laplacian.form(model.mass() / 1e-4, 0.0, 1.0, nullptr, A);
-  PrefactoredCholesky factor(copy ? PrefactoredCholesky::kDefaultCopyLimit * 1000 : 0);
+  PrefactoredCholesky factor(
+      way == KeptFactorWay::Copy ? PrefactoredCholesky::kDefaultCopyLimit * 1000 : 0,
+      way == KeptFactorWay::Single);
   if (!factor.factorize(A).ok) st.SkipWithError("factorization failed");
-  Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(3 * model.numPoints(), -1.0, 1.0);
+  const Eigen::VectorXd start = Eigen::VectorXd::LinSpaced(3 * model.numPoints(), -1.0, 1.0);
+  Eigen::VectorXd b = start;
   for (auto _ : st) {
+    // The same right-hand side each time: solved in place again and again it would shrink
+    // into subnormal numbers (A's smallest eigenvalue is M/h^2 > 1), which time differently.
+    b = start;
     if (!factor.solve(b.data(), 3).ok) st.SkipWithError("solve failed");
     benchmark::DoNotOptimize(b.data());
   }
   st.counters["nnz_L"] = static_cast<double>(factor.nonZeros());
 }
-BENCHMARK_CAPTURE(BM_KeptFactorSolve, copy, true)
+BENCHMARK_CAPTURE(BM_KeptFactorSolve, copy, KeptFactorWay::Copy)
     ->Arg(8)
     ->Arg(12)
     ->Arg(16)
     ->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_KeptFactorSolve, cholmod, false)
+BENCHMARK_CAPTURE(BM_KeptFactorSolve, single, KeptFactorWay::Single)
     ->Arg(8)
     ->Arg(12)
     ->Arg(16)
+    ->Arg(24)
+    ->Arg(32)
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_KeptFactorSolve, cholmod, KeptFactorWay::Cholmod)
+    ->Arg(8)
+    ->Arg(12)
+    ->Arg(16)
+    ->Arg(24)
+    ->Arg(32)
     ->Unit(benchmark::kMicrosecond);
 
 // Runs `sim` to t = 1 s; false if it diverged.
