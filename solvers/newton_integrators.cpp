@@ -10,9 +10,8 @@
 namespace jello {
 namespace {
 
-// The seed iterations stop at this relative residual: from there Newton converges in one or two
-// iterations, where the seed's linear convergence would need many.
-constexpr double kSeedResidual = 1e-4;
+// Plain seed iterations before Chebyshev's start (ProjectiveOptions::chebyshevDelay's default).
+constexpr int kSeedChebyshevDelay = 2;
 
 // Unknown: the displacement d = y - x0 (small, so no digits are lost to the positions' size).
 // Forms are filled into the integrator's own, so their vectors are allocated once.
@@ -99,15 +98,44 @@ StepResult NewtonIntegrator::seed(const Model& model, double inertia, double h) 
   const auto [a, b] = matrixCoefficients(h);
   if (StepResult res = system_.factorProjective(a, b); !res.ok) return res;
   const double scale = -h * h / form_.gamma;
+  // Chebyshev (ProjectiveOptions::chebyshevRho): omega 1 while plain.
+  const double rho = options_.seedChebyshevRho;
+  double omega = 1.0, firstResidual = 0.0;
+  int plainSince = 0;
   for (int k = 0; k < options_.seedIterations; ++k) {
     if (interruptRequested()) return StepResult::interruption();
     evaluate(model, inertia, d_);  // x_e of d_ into xe_
     if (model.inContact(xe_.data())) break;
-    if (lastResidual_ <= kSeedResidual) break;
+    if (lastResidual_ <= options_.seedTolerance) break;
     delta_ = scale * r_;
     if (StepResult res = system_.solveProjective(delta_); !res.ok) return res;
-    d_ += delta_;
     ++seeds_;
+    if (rho <= 0.0) {
+      d_ += delta_;
+      continue;
+    }
+    const int plain = k - plainSince;
+    if (plain == 0) firstResidual = lastResidual_;
+    if (omega != 1.0 && lastResidual_ > firstResidual) {
+      // Grown beyond the run's first: the plain update, and the count starts again.
+      omega = 1.0;
+      plainSince = k;
+      firstResidual = lastResidual_;
+      ++seedRestarts_;
+    } else if (plain == kSeedChebyshevDelay) {
+      omega = 2.0 / (2.0 - rho * rho);
+    } else if (plain > kSeedChebyshevDelay) {
+      omega = 4.0 / (4.0 - rho * rho * omega);
+    }
+    if (omega == 1.0) {
+      previousSeed_ = d_;
+      d_ += delta_;
+    } else {
+      // d_next = omega (d + delta - previous) + previous.
+      dTrial_ = omega * (d_ + delta_ - previousSeed_) + previousSeed_;
+      previousSeed_ = d_;
+      d_ = dTrial_;
+    }
   }
   return StepResult::success();
 }
@@ -234,6 +262,7 @@ std::vector<Statistic> NewtonIntegrator::statistics() const {
       {"line_search_failures", static_cast<double>(searchFailures_)},
       {"factor_reuses", static_cast<double>(reuses_)},
       {"seed_iterations", static_cast<double>(seeds_)},
+      {"seed_chebyshev_restarts", static_cast<double>(seedRestarts_)},
   };
   system_.appendStatistics(stats);
   return stats;

@@ -114,11 +114,12 @@ class NewtonIntegrator : public Integrator {
   // Workspaces: positions and velocities where forces are evaluated, force, residual, update.
   ImplicitStepForm form_;  // the current step's
   Eigen::VectorXd d_, dTrial_, xe_, ve_, f_, r_, rhs_, delta_, trial_, external_, dv_;
+  Eigen::VectorXd previousSeed_;  // the seed iterate before d_ (Chebyshev)
   int lastIterations_ = 0;
   double lastResidual_ = 0.0;
   bool lastConverged_ = true;
   long steps_ = 0, iterations_ = 0, maxIterations_ = 0, cuts_ = 0, searchFailures_ = 0,
-       unconverged_ = 0, reuses_ = 0, seeds_ = 0;
+       unconverged_ = 0, reuses_ = 0, seeds_ = 0, seedRestarts_ = 0;
 };
 
 // The four methods state only their forms; construction is the base's (ImplicitOptions or

@@ -28,6 +28,12 @@ struct ImplicitOptions {
   // per step size; each costs a force evaluation and a back-substitution, no assembly. They stop
   // at the first iterate in contact (P does not bound the penalty springs). 0: none.
   int seedIterations = 0;
+  // The seeds stop at this relative residual, from where Newton converges in one or two
+  // iterations; at or below newtonTolerance they may converge the step themselves (with
+  // Chebyshev acceleration, cheaper than Newton's iterations: README "Implicit solvers").
+  double seedTolerance = 1e-4;
+  // Chebyshev acceleration of the seeds (Wang 2015; ProjectiveOptions::chebyshevRho): 0 off.
+  double seedChebyshevRho = 0.0;
   // implicit-linear (one solve per step): a step during which a contact begins is not near its
   // linearization (the penalty spring was not in the matrix), so it gets up to this many
   // Newton iterations, to this relative residual: the penalty must act, that's all.

@@ -191,6 +191,8 @@ void Panel::solverOptions(const Frame& frame, SimRunner& runner) {
     newtonTolerance_ = static_cast<float>(options_.implicit.newtonTolerance);
     rtol_ = static_cast<float>(options_.cvode.rtol);
     chebyshevRho_ = static_cast<float>(options_.projective.chebyshevRho);
+    seedTolerance_ = static_cast<float>(options_.implicit.seedTolerance);
+    seedChebyshevRho_ = static_cast<float>(options_.implicit.seedChebyshevRho);
   }
   SolverOptions& o = options_;
   bool changed = false;
@@ -221,6 +223,13 @@ void Panel::solverOptions(const Frame& frame, SimRunner& runner) {
       changed |= released();
       changed |= ImGui::Checkbox("keep factor", &o.implicit.reuseFactor);
       ImGui::SliderInt("seed iterations", &o.implicit.seedIterations, 0, 100);
+      changed |= released();
+      if (logSlider("seed tol", &seedTolerance_, 1e-12f, 1e-2f, "%.1e")) {
+        o.implicit.seedTolerance = seedTolerance_;
+        changed = true;
+      }
+      ImGui::SliderFloat("seed Chebyshev rho", &seedChebyshevRho_, 0.0f, 0.99f, "%.2f");
+      o.implicit.seedChebyshevRho = seedChebyshevRho_;
       changed |= released();
       break;
     case IntegratorKind::Cvode: {

@@ -73,6 +73,7 @@ class Panel {
   float pullScale_ = 1;
   SolverOptions options_;  // the solver section's copy while editing
   float newtonTolerance_ = 1e-8f, rtol_ = 1e-6f, chebyshevRho_ = 0.0f;
+  float seedTolerance_ = 1e-4f, seedChebyshevRho_ = 0.0f;
   std::optional<Plane> savedPlane_;
   std::optional<Sphere> savedSphere_;
   bool plane_ = false, sphere_ = false;

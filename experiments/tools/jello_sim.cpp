@@ -403,6 +403,19 @@ int main(int argc, char** argv) {
       ->check(jello::cli::range(0, 1000))
       ->capture_default_str()
       ->group(implicitGroup);
+  app.add_option("--newton-seed-tol", implicit.seedTolerance,
+                 "implicit, midpoint, newmark, bdf2: relative residual that ends the seed "
+                 "iterations (at or below --newton-tol they may converge the step themselves)")
+      ->check(jello::cli::positive())
+      ->capture_default_str()
+      ->group(implicitGroup);
+  app.add_option("--newton-seed-chebyshev", implicit.seedChebyshevRho,
+                 "implicit, midpoint, newmark, bdf2: Chebyshev acceleration of the seed "
+                 "iterations with this rho, as --projective-chebyshev (0: off; 0.9 measured "
+                 "best with --newton-seed-tol 1e-8)")
+      ->check(jello::cli::range(0.0, 0.999))
+      ->capture_default_str()
+      ->group(implicitGroup);
   auto& projective = opt.solver.projective;
   app.add_option("--projective-iters", projective.iterations,
                  "projective: local/global iterations per step")

@@ -16,6 +16,11 @@ from conftest import program
     ("bdf2", 0.005, 20, {"newton_tol": 1e-10}, ["--newton-tol", "1e-10"]),
     ("projective", 0.01, 10, {"projective_iters": 5}, ["--projective-iters", "5"]),
     ("projective", 0.01, 10, {"projective_chebyshev": 0.85}, ["--projective-chebyshev", "0.85"]),
+    ("implicit", 0.01, 10,
+     {"preconditioner": "projective", "newton_seed": 60, "newton_seed_tol": 1e-8,
+      "newton_seed_chebyshev": 0.9},
+     ["--preconditioner", "projective", "--newton-seed", "60", "--newton-seed-tol", "1e-8",
+      "--newton-seed-chebyshev", "0.9"]),
     ("cvode", 0.01, 5, {"rtol": 1e-4, "cvode_method": "adams"},
      ["--rtol", "1e-4", "--cvode-method", "adams"]),
 ])
@@ -153,6 +158,10 @@ def test_seeded_newton_takes_the_default_steps():
         jello.Simulation(world, integrator="implicit", newton_seed=-1)
     with pytest.raises(ValueError, match="projective_chebyshev"):
         jello.Simulation(world, integrator="projective", projective_chebyshev=1.0)
+    with pytest.raises(ValueError, match="newton_seed_chebyshev"):
+        jello.Simulation(world, integrator="implicit", newton_seed_chebyshev=float("nan"))
+    with pytest.raises(ValueError, match="newton_seed_tol"):
+        jello.Simulation(world, integrator="implicit", newton_seed_tol=0.0)
 
 
 def test_run_callback_every_and_stop(jello_w):

@@ -137,10 +137,16 @@ void translateExceptions(std::exception_ptr p) {
 // The keywords mirror jello-sim's flags with '_' for '-' (README "From Python").
 constexpr const char* kSolverOptionNames =
     "linear_solver, preconditioner, matrix_free, clamp, cg_tol, newton_iters, newton_tol, "
-    "newton_xtol, factor_reuse, newton_seed, "
+    "newton_xtol, factor_reuse, newton_seed, newton_seed_tol, newton_seed_chebyshev, "
     "refactor_ratio, projective_iters, projective_tol, projective_chebyshev, rtol, cvode_method, "
     "cvode_krylov, atol, "
     "atol_x, atol_v, contact_roots, max_order, stab_lim_det, max_step";
+
+// A Chebyshev contraction rho: in [0, 1).
+double chebyshevRho(double rho, const char* name) {
+  if (!(rho >= 0.0 && rho < 1.0)) valueError(std::string(name) + " must be at least 0 and below 1");
+  return rho;
+}
 
 bool boolOption(const py::handle& v, const std::string& name) {
   if (!py::isinstance<py::bool_>(v)) valueError(name + " must be True or False");
@@ -180,6 +186,10 @@ jello::SolverOptions solverOptionsFrom(const py::kwargs& kwargs, jello::SolverOp
       o.implicit.reuseFactor = boolOption(value, name);
     } else if (name == "newton_seed") {
       o.implicit.seedIterations = int(inRange(as<long>(value, name), 0, 1000, n));
+    } else if (name == "newton_seed_tol") {
+      o.implicit.seedTolerance = positive(real(), n);
+    } else if (name == "newton_seed_chebyshev") {
+      o.implicit.seedChebyshevRho = chebyshevRho(real(), n);
     } else if (name == "refactor_ratio") {
       const double r = positive(real(), n);
       if (r < 1e-6 || r > 1.0) valueError("refactor_ratio must be between 1e-6 and 1");
@@ -189,9 +199,7 @@ jello::SolverOptions solverOptionsFrom(const py::kwargs& kwargs, jello::SolverOp
     } else if (name == "projective_tol") {
       o.projective.tolerance = nonNegative(real(), n);
     } else if (name == "projective_chebyshev") {
-      const double rho = nonNegative(real(), n);
-      if (rho >= 1.0) valueError("projective_chebyshev must be at least 0 and below 1");
-      o.projective.chebyshevRho = rho;
+      o.projective.chebyshevRho = chebyshevRho(real(), n);
     } else if (name == "rtol") {
       o.cvode.rtol = positive(real(), n);
     } else if (name == "cvode_method") {
