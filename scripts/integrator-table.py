@@ -50,8 +50,8 @@ FACTOR_JSON = os.path.join(ROOT, "experiments", "results", "kept_factor.json")
 # name them.
 VARIANTS = {
     "implicit-cholmod": "`implicit`, CHOLMOD",
-    "implicit-fast": "`implicit`, CG (projective) after up to 30 seed iterations",
-    "bdf2-fast": "`bdf2`, CG (projective) after up to 30 seed iterations",
+    "implicit-fast": "`implicit`, CG (projective) after up to 60 Chebyshev seed iterations",
+    "bdf2-fast": "`bdf2`, CG (projective) after up to 60 Chebyshev seed iterations",
 }
 
 
@@ -64,7 +64,8 @@ RUNS = [
     ("rk4", 1e-4, []),
     ("implicit", 0.01, []),
     ("implicit", 0.01, ["--linear-solver", "cholmod"]),
-    ("implicit", 0.01, ["--preconditioner", "projective", "--newton-seed", "30"]),
+    ("implicit", 0.01, ["--preconditioner", "projective", "--newton-seed", "60",
+                        "--newton-seed-tol", "1e-8", "--newton-seed-chebyshev", "0.9"]),
     ("implicit-linear", 0.01, []),
     ("midpoint", 0.01, []),
     ("newmark", 0.01, []),
@@ -152,15 +153,26 @@ def steps_table_from_json():
         ms = b["real_time"] * {"ms": 1.0, "s": 1e3, "us": 1e-3}[b["time_unit"]]
         newton = b.get("newton_per_step")
         cells[(name, n.split(":")[1], spinning.split(":")[1])] = (ms, newton)
-    lines = ["| integrator | jello.w 8^3 | spinning cube 8^3 | jello.w 16^3 | spinning cube 16^3 |",
-             "|---|---|---|---|---|"]
+    columns = [(n, spinning) for n in ("8", "16", "32") for spinning in ("0", "1")
+               if any((name, n, spinning) in cells for name in order)]
+    lines = ["| integrator | " + " | ".join(
+                 f"{'spinning cube' if spinning == '1' else 'jello.w'} {n}^3"
+                 for n, spinning in columns) + " |",
+             "|---|" + "---|" * len(columns)]
     for name in order:
         row = [label(name)]
-        for n, spinning in (("8", "0"), ("8", "1"), ("16", "0"), ("16", "1")):
-            ms, newton = cells[(name, n, spinning)]
+        for column in columns:
+            if (name, *column) not in cells:  # 32^3: projective alone
+                row.append("")
+                continue
+            ms, newton = cells[(name, *column)]
             text = f"{ms:.3g} ms" if ms < 1000 else f"{ms / 1e3:.3g} s"
             row.append(text + (f" ({newton:.2g} it.)" if newton is not None else ""))
         lines.append("| " + " | ".join(row) + " |")
+    date = data["context"]["date"][:10]
+    lines.append("")
+    lines.append(f"{date}, one core; each figure a step after a first step timed apart "
+                 "(`first_step_ms` in the JSON).")
     return "\n".join(lines)
 
 
@@ -228,7 +240,8 @@ def cvode_table_from_json():
 
 
 def kept_factor_table_from_json():
-    """Three right-hand sides through projective's kept factor: the copy against CHOLMOD."""
+    """Three right-hand sides through projective's kept factor: the copy and the
+    single-precision supernodes against CHOLMOD."""
     with open(FACTOR_JSON) as f:
         data = json.load(f)
     cells, sizes = {}, []
@@ -241,14 +254,19 @@ def kept_factor_table_from_json():
             sizes.append(n)
         cells[(how, n)] = (milliseconds(b), b["nnz_L"])
     lines = ["| three right-hand sides, M/h^2 + L | " +
-             " | ".join(f"{n}^3 (L: {cells[('copy', n)][1]:,.0f} entries)" for n in sizes) + " |",
+             " | ".join(f"{n}^3 (L: {cells[('cholmod', n)][1]:,.0f} entries)" for n in sizes) +
+             " |",
              "|---|" + "---|" * len(sizes)]
-    for how, text in (("copy", "our substitutions over the copied factor"),
-                      ("cholmod", "CHOLMOD's `cholmod_solve2`")):
-        lines.append(f"| {text} | " + " | ".join(duration_fine(cells[(how, n)][0])
-                                                 for n in sizes) + " |")
-    lines.append("| ratio | " + " | ".join(
-        f"{cells[('copy', n)][0] / cells[('cholmod', n)][0]:.2f}" for n in sizes) + " |")
+    ways = (("copy", "our substitutions over the copied factor"),
+            ("single", "our substitutions over its supernodes in single precision"),
+            ("cholmod", "CHOLMOD's `cholmod_solve2`"))
+    for how, text in ways:
+        lines.append(f"| {text} | " + " | ".join(
+            duration_fine(cells[(how, n)][0]) if (how, n) in cells else "" for n in sizes) + " |")
+    for how, text in ways[:2]:
+        lines.append(f"| {how} / CHOLMOD | " + " | ".join(
+            f"{cells[(how, n)][0] / cells[('cholmod', n)][0]:.2f}" if (how, n) in cells else ""
+            for n in sizes) + " |")
     date = data["context"]["date"][:10]
     lines.append("")
     lines.append(f"Medians of 3 runs, {date}, one core (`experiments/results/kept_factor.json`).")
