@@ -14,17 +14,37 @@ namespace jello::experiments {
 
 using Fit = Eigen::Matrix<double, 3, 4>;
 
-World atlasScene(double k, int n) {
+std::optional<AtlasScene> parseAtlasScene(const std::string& name) {
+  if (name == "falling") return AtlasScene::Falling;
+  if (name == "free") return AtlasScene::Free;
+  return std::nullopt;
+}
+
+std::string describe(AtlasScene scene) {
+  return scene == AtlasScene::Falling
+             ? "cube at rest shape thrown at 0.5 m/s and spinning 2 rad/s about z, falling 1.5 m "
+               "onto the floor under gravity, c = 0.25 N*s/m"
+             : "cube at rest shape thrown at 0.5 m/s and spinning 2 rad/s about z, no gravity, "
+               "touching nothing within the window, c = 0.25 N*s/m";
+}
+
+World atlasScene(double k, int n, AtlasScene scene) {
   SceneSpec spec = stiffCube(k);  // c = 0.25 N*s/m, no plane
   spec.cubeResolution = n;
   spec.pose = PosePreset::Rest;
   spec.velocity = {0.5, 0.0, 0.0};
   spec.spin = 2.0;
-  spec.field = FieldPreset::Gravity;
-  spec.fieldStrength = defaultFieldStrength(FieldPreset::Gravity, spec.mass);
-  spec.fieldResolution = 2;  // uniform
+  if (scene == AtlasScene::Falling) {
+    spec.field = FieldPreset::Gravity;
+    spec.fieldStrength = defaultFieldStrength(FieldPreset::Gravity, spec.mass);
+    spec.fieldResolution = 2;  // uniform
+  } else {
+    spec.fieldResolution = 0;
+  }
   World w = buildWorld(spec);
-  // Centred above the floor (z = -2): 1.5 m of fall, the floor reached after about 0.55 s.
+  // Centred in the box: falling, 1.5 m above the floor (z = -2), reached after about 0.55 s;
+  // free, 1 s of drift moves it 0.5 m, its corners (0.87 m from the centre) stay 0.6 m from
+  // the walls.
   for (Vec3& p : w.positions) p += Vec3{-0.5, -0.5, -0.5};
   return w;
 }

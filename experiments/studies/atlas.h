@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,8 +28,15 @@ struct AtlasSetup {
   int halvings = 7;          // step sizes tried per integrator (explicit: below its limit)
 };
 
+// The atlas's scenes: `falling` (the default) is the cube thrown sideways and spinning, falling
+// onto the floor under gravity and bouncing; `free` the same throw and spin without gravity,
+// which touches nothing within the window: only rigid motion and what the spin stretches.
+enum class AtlasScene { Falling, Free };
+std::optional<AtlasScene> parseAtlasScene(const std::string& name);
+std::string describe(AtlasScene scene);
+
 // The scene at stiffness k (c = 0.25 N*s/m), N^3 points of 1/512 kg (w_max does not depend on N).
-World atlasScene(double k, int n);
+World atlasScene(double k, int n, AtlasScene scene = AtlasScene::Falling);
 
 // Visible motion: the least-squares affine map x = A r + t of the rest lattice (r centred) onto
 // a state, and the largest distance between two such maps at the cube's corners.

@@ -6,6 +6,7 @@
 // Also the crossover atlas (atlas.h): over k and N, each integrator's cost at the largest step
 // that keeps the visible motion within a tolerance.
 //   jello-scaling [--quick] [--n LIST] [--budget S] [--atlas-k LIST] [--atlas-n LIST]
+//                 [--atlas-scene falling|free]
 //                 [--out-dir DIR] [--jobs N]
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -95,6 +96,12 @@ int main(int argc, char** argv) {
                  "The atlas's accuracy on the visible motion, m at the corners")
       ->check(jello::cli::positive())
       ->capture_default_str();
+  std::string atlasSceneName = "falling";
+  app.add_option("--atlas-scene", atlasSceneName,
+                 "The atlas's scene: falling (thrown, spinning, onto the floor under gravity) or "
+                 "free (the same throw and spin without gravity: no contact)")
+      ->check(CLI::IsMember({"falling", "free"}))
+      ->capture_default_str();
   app.add_option("--atlas-budget", atlas.runBudget,
                  "Wall seconds of one atlas run beyond which smaller steps are not tried")
       ->check(jello::cli::positive())
@@ -127,6 +134,7 @@ int main(int argc, char** argv) {
     atlas.halvings = 4;
   }
   if (noGrid) ns.clear();
+  const AtlasScene scene = *parseAtlasScene(atlasSceneName);
   // The atlas's points, the costliest (largest N, then k) first; each computes its reference.
   std::vector<std::pair<double, int>> atlasPoints;
   for (int n : atlasN) {
@@ -167,7 +175,7 @@ int main(int argc, char** argv) {
       [&](int i) {
         if (i >= int(tasks.size())) {
           const auto [ak, an] = atlasPoints[static_cast<std::size_t>(i) - tasks.size()];
-          const World w = atlasScene(ak, an);
+          const World w = atlasScene(ak, an, scene);
           const AtlasReference reference = atlasReference(w, atlas);
           for (IntegratorKind kind : atlasIntegrators(quick)) {
             atlasPoint(w, ak, an, kind, reference, atlas, atlasRows);
@@ -227,9 +235,8 @@ int main(int argc, char** argv) {
       {"atlas",
        {{"k_N_per_m", atlasK},
         {"n", atlasN},
-        {"scene",
-         "cube at rest shape thrown at 0.5 m/s and spinning 2 rad/s about z, falling 1.5 m onto "
-         "the floor under gravity, c = 0.25 N*s/m"},
+        {"scene_name", atlasSceneName},
+        {"scene", describe(scene)},
         {"time_s", atlas.time},
         {"sample_interval_s", atlas.interval},
         {"tolerance_m", atlas.tolerance},
