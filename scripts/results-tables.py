@@ -8,7 +8,9 @@ experiments/results/stability.csv and its sidecar) and <!-- work-precision-summa
 from experiments/results/work_precision.csv and its sidecar), <!-- implicit-damping:... -->
 <!-- scaling-summary:... --> (cost per simulated second against N, from scaling.csv) and
 <!-- drift-summary:... --> (the long-run drift of energy and angular momentum per integrator,
-from work_precision_drift_summary.csv) in README.md. With --check it changes
+from work_precision_drift_summary.csv), the crossover atlas's (atlas-summary and atlas-region
+from every *_atlas.csv; atlas-free-summary from experiments/results/atlas_free/) in README.md.
+With --check it changes
 nothing and exits 1 when README.md differs from what the data gives (ctest runs it so).
 
     scripts/results-tables.py [--check]
@@ -260,16 +262,23 @@ def scaling_summary():
     return "\n".join(lines)
 
 
+# The free scene's atlas (jello-scaling --atlas-scene free) has its own directory.
+ATLAS_FREE = "atlas_free"
+
+
 @functools.lru_cache(maxsize=None)
-def atlas_sources():
-    """Every committed atlas: (rows, sidecar) of scaling_atlas.csv (jello-scaling's full run) and
-    of each NAME_atlas.csv an atlas-only run wrote (NAME.json its sidecar), by N; an N in two
-    files is an error. Read once (three blocks use it); not to be modified."""
-    names = sorted(f[:-len("_atlas.csv")] for f in os.listdir(RESULTS) if f.endswith("_atlas.csv"))
+def atlas_sources(subdirectory=""):
+    """Every committed atlas of a scene: (rows, sidecar) of scaling_atlas.csv (jello-scaling's
+    full run) and of each NAME_atlas.csv an atlas-only run wrote (NAME.json its sidecar), by N,
+    from experiments/results (the falling scene) or a subdirectory of it (ATLAS_FREE); an N in
+    two files is an error. Read once (several blocks use it); not to be modified."""
+    directory = os.path.join(RESULTS, subdirectory)
+    names = sorted(f[:-len("_atlas.csv")] for f in os.listdir(directory)
+                   if f.endswith("_atlas.csv"))
     by_n = {}
     for name in names:
-        sidecar = read_sidecar(name)
-        for r in read_rows(name + "_atlas"):
+        sidecar = read_sidecar(os.path.join(subdirectory, name))
+        for r in read_rows(os.path.join(subdirectory, name + "_atlas")):
             n = int(r["n"])
             if n in by_n and by_n[n][1] is not sidecar:
                 raise SystemExit(f"results-tables: the atlas at N = {n} is in two files")
@@ -288,8 +297,8 @@ def atlas_cheapest(rows, explicit=None):
     return min(ok, key=lambda r: float(r["wall_per_simulated_s"]), default=None)
 
 
-def atlas_summary():
-    by_n = atlas_sources()
+def atlas_summary(subdirectory=""):
+    by_n = atlas_sources(subdirectory)
     first = next(iter(by_n.values()))[1]["parameters"]["atlas"]
     checks = [float(r["reference_check_m"]) for rows, _ in by_n.values() for r in rows]
     lines = [f"Visible motion within {100 * first['tolerance_m']:g} cm at the corners over "
@@ -383,6 +392,11 @@ def experiments_runtime():
         text += (" The atlas at " + " and ".join(f"N = {n}" for n, _ in extra) + " took " +
                  " and ".join(f"{t / 60:.0f} min" for _, t in extra) +
                  ", each on one core of the same machine, side by side.")
+    free = sorted((int(rows[0]["n"]), sidecar["wall_time_s"])
+                  for rows, sidecar in atlas_sources(ATLAS_FREE).values())
+    if free:
+        text += (" The free scene's atlas at " + " and ".join(f"N = {n}" for n, _ in free) +
+                 " took " + " and ".join(f"{t / 60:.0f} min" for _, t in free) + " on one core.")
     return text
 
 
@@ -393,6 +407,7 @@ BLOCKS = {"stability-summary": stability_summary,
           "drift-summary": drift_summary,
           "atlas-summary": atlas_summary,
           "atlas-region": atlas_region,
+          "atlas-free-summary": lambda: atlas_summary(ATLAS_FREE),
           "experiments-runtime": experiments_runtime}
 
 

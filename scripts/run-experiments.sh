@@ -6,6 +6,8 @@
 # `scripts/run-experiments.sh atlas` runs the crossover atlas at N = 16 (k = 1e2..1e8) and N = 32
 # (k = 1e2..1e6; above, its RK4 reference alone is hours) instead, side by side, one core each
 # (about an hour and a half on a 2-core VM), and redraws the atlas charts.
+# `scripts/run-experiments.sh atlas-free` runs the atlas's second scene (the same throw and spin
+# without gravity: no contact) at N = 8 into experiments/results/atlas_free/, and draws its chart.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -48,6 +50,17 @@ if [ "${1:-}" = atlas ]; then
   wait "$first"
   draw_atlas
   echo "run-experiments: the atlas at N = 16 and 32 in $out/"
+  exit 0
+fi
+if [ "${1:-}" = atlas-free ]; then
+  export OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1
+  free="$out/atlas_free"
+  mkdir -p "$free"
+  taskset -c 1 "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 8 --jobs 1 \
+    --out-dir "$free"
+  gnuplot -e "dir='$free'; atlas_ns='8'; atlas_only=1; scene=' (free flight)'" \
+    experiments/plots/scaling.gp
+  echo "run-experiments: the free scene's atlas in $free/"
   exit 0
 fi
 "$bin/jello-stability" "${args[@]}" --out-dir "$out"

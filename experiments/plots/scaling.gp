@@ -1,7 +1,11 @@
 # Scaling from scaling.csv: wall time per simulated second against cube resolution N; and the
 # crossover atlas from every *_atlas.csv (scaling_atlas.csv and the atlas-only runs').
 # gnuplot -e "dir='experiments/results'; atlas_ns='8 16 32'" experiments/plots/scaling.gp
+# A directory of atlas-only runs (the free scene's) draws the atlas alone:
+# gnuplot -e "dir='experiments/results/atlas_free'; atlas_ns='8'; atlas_only=1; scene=' (free flight)'" ...
 if (!exists("dir")) dir = 'experiments/results'
+if (!exists("atlas_only")) atlas_only = 0
+if (!exists("scene")) scene = ''
 csv = dir.'/scaling.csv'
 set datafile separator ','
 set logscale xy
@@ -12,7 +16,7 @@ set ylabel 'wall seconds per simulated second'
 sel(integ, solver) = sprintf("< awk -F, '$4==\"%s\" && $5==\"%s\"' %s | sort -t, -k1,1n", integ, solver, csv)
 set xtics (6, 8, 12, 16, 24, 32)
 set xrange [5.5:36]
-do for [fmt in "pngcairo svg"] {
+do for [fmt in (atlas_only ? "" : "pngcairo svg")] {
   if (fmt eq "pngcairo") { set terminal pngcairo size 900,560 font ",10"; set output dir.'/scaling.png' } \
   else { set terminal svg size 900,560 font ",10"; set output dir.'/scaling.svg' }
   set title 'Cost against cube size (k = 10^4; explicit at 0.9 of their limit, implicit dt 0.01, cvode rtol 1e-3)'
@@ -46,7 +50,7 @@ do for [n in atlas_ns] {
   do for [fmt in "pngcairo svg"] {
     if (fmt eq "pngcairo") { set terminal pngcairo size 900,560 font ",10"; set output dir.'/atlas_n'.n.'.png' } \
     else { set terminal svg size 900,560 font ",10"; set output dir.'/atlas_n'.n.'.svg' }
-    set title 'Crossover atlas, N = '.n.': cost at the largest step keeping the visible motion within 1 cm (a missing point: not reached)'
+    set title 'Crossover atlas'.scene.', N = '.n.': cost at the largest step keeping the visible motion within 1 cm'."\n".'(a missing point: not reached)'
     plot for [i=1:10] asel(n, word(aintegrators,i)) using 1:8 with linespoints pt (word(apoints,i)+0) lw 2 lc rgb word(acolors,i) title word(aintegrators,i)
     set output
   }
@@ -69,7 +73,7 @@ set ytics (8, 16, 32)
 set format y '%g'
 set ylabel 'cube resolution N'
 unset grid
-do for [fmt in "pngcairo svg"] {
+do for [fmt in (atlas_only ? "" : "pngcairo svg")] {
   if (fmt eq "pngcairo") { set terminal pngcairo size 1000,420 font ",10"; set output dir.'/atlas_region.png' } \
   else { set terminal svg size 1000,420 font ",10"; set output dir.'/atlas_region.svg' }
   set title 'Crossover atlas: the cheapest integrator keeping the visible motion within 1 cm, and its wall time per simulated second'

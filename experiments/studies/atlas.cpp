@@ -171,7 +171,7 @@ AtlasReference atlasReference(const World& w, const AtlasSetup& setup) {
 std::vector<IntegratorKind> atlasIntegrators(bool quick) {
   if (quick) {
     return {IntegratorKind::Symplectic, IntegratorKind::RK4, IntegratorKind::Implicit,
-            IntegratorKind::Midpoint};
+            IntegratorKind::Midpoint, IntegratorKind::Projective};
   }
   return {IntegratorKind::Euler,    IntegratorKind::Symplectic,     IntegratorKind::RK4,
           IntegratorKind::Implicit, IntegratorKind::ImplicitLinear, IntegratorKind::Midpoint,

@@ -60,7 +60,8 @@ struct AtlasReference {
 };
 AtlasReference atlasReference(const World& w, const AtlasSetup& setup);
 
-// The integrators an atlas point compares (quick: symplectic, rk4, implicit, midpoint).
+// The integrators an atlas point compares (quick: symplectic, rk4, implicit, midpoint,
+// projective).
 std::vector<IntegratorKind> atlasIntegrators(bool quick);
 
 CsvTable atlasTable();

@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
                "Leave the resolution grid out: the atlas alone (NAME.csv holds only its header)");
   app.add_flag("--quick", quick,
                "CI: N = 6 and 8, 0.3 s per point; the atlas at k = 1e3 and 1e5, N = 8, with "
-               "symplectic, rk4, implicit and midpoint, 4 steps tried each");
+               "symplectic, rk4, implicit, midpoint and projective, 4 steps tried each");
   app.add_flag("--quiet", quiet, "No progress line");
   try {
     app.parse(argc, argv);

@@ -67,6 +67,7 @@ def other_tables():
             "drift-summary": load("scripts/results-tables.py").drift_summary(),
             "atlas-summary": load("scripts/results-tables.py").atlas_summary(),
             "atlas-region": load("scripts/results-tables.py").atlas_region(),
+            "atlas-free-summary": load("scripts/results-tables.py").atlas_summary("atlas_free"),
             "experiments-runtime": load("scripts/results-tables.py").experiments_runtime()}
 
 
