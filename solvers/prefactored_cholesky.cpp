@@ -1,16 +1,13 @@
 #include "solvers/prefactored_cholesky.h"
 
 #include <cholmod.h>
-#ifdef __AVX__
-#include <immintrin.h>
-#endif
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <string>
 
 #include "solvers/blas_headroom.h"
+#include "solvers/single_supernodes.h"
 
 namespace jello {
 namespace {
@@ -48,177 +45,6 @@ void substitute(int n, const std::vector<int>& rowStart, const std::vector<int>&
   }
 }
 
-// The supernodal substitutions over the single-precision copy: supernode k holds columns
-// first[k] .. first[k+1]-1 of L, dense and by columns, over the rows rows[rowStart[k]] ..
-// (the first `width` of which are its own columns), at values[valueStart[k]]. Entries are read
-// as floats (half the memory traffic of CHOLMOD's doubles: these solves are bound by it) and
-// every product and sum is in double. The right-hand sides are solved side by side, each
-// contiguous, four rows to a vector.
-struct Supernodes {
-  std::vector<int> first, rowStart, rows;
-  std::vector<long> valueStart;
-  std::vector<float> values;
-  std::vector<double> inverseDiagonal;
-  int tallest = 0;           // the most rows of a supernode
-  std::vector<double> work;  // a supernode's rows per right-hand side, gathered
-  std::vector<double> y;     // the permuted right-hand sides
-};
-
-using Floats4 = float __attribute__((vector_size(16)));
-using Doubles4 = double __attribute__((vector_size(32)));
-
-inline Doubles4 widen(const float* p) {
-#ifdef __AVX__
-  return Doubles4(_mm256_cvtps_pd(_mm_loadu_ps(p)));  // one instruction, where the generic
-#else                                                 // conversion below compiles to four
-  Floats4 f;
-  std::memcpy(&f, p, sizeof f);
-  return __builtin_convertvector(f, Doubles4);
-#endif
-}
-inline Doubles4 load(const double* p) {
-  Doubles4 d;
-  std::memcpy(&d, p, sizeof d);
-  return d;
-}
-inline void store(double* p, Doubles4 d) {
-  std::memcpy(p, &d, sizeof d);
-}
-inline double total(Doubles4 v) {
-  return (v[0] + v[1]) + (v[2] + v[3]);
-}
-
-// y[i] -= sum over the q < B columns of l[q][i] a[q], i < count.
-template <int B>
-void subtractColumns(double* y, const float* const* l, const double* a, int count) {
-  int i = 0;
-  for (; i + 4 <= count; i += 4) {
-    Doubles4 sum = widen(l[0] + i) * a[0];
-    for (int q = 1; q < B; ++q) sum += widen(l[q] + i) * a[q];
-    store(y + i, load(y + i) - sum);
-  }
-  for (; i < count; ++i) {
-    double sum = 0.0;
-    for (int q = 0; q < B; ++q) sum += double(l[q][i]) * a[q];
-    y[i] -= sum;
-  }
-}
-
-// out[q] = sum over i < count of l[q][i] x[i], for the q < B columns. One column runs over four
-// accumulators: a single one would wait on the adder's latency at every step.
-template <int B>
-void dotColumns(const float* const* l, const double* x, int count, double* out) {
-  constexpr int kChains = B == 1 ? 4 : 1;
-  Doubles4 sum[B][kChains] = {};
-  int i = 0;
-  for (; i + 4 * kChains <= count; i += 4 * kChains) {
-    for (int u = 0; u < kChains; ++u) {
-      const Doubles4 xi = load(x + i + 4 * u);
-      for (int q = 0; q < B; ++q) sum[q][u] += widen(l[q] + i + 4 * u) * xi;
-    }
-  }
-  for (; i + 4 <= count; i += 4) {
-    const Doubles4 xi = load(x + i);
-    for (int q = 0; q < B; ++q) sum[q][0] += widen(l[q] + i) * xi;
-  }
-  for (int q = 0; q < B; ++q) {
-    Doubles4 all = sum[q][0];
-    for (int u = 1; u < kChains; ++u) all += sum[q][u];
-    double rest = 0.0;
-    for (int r = i; r < count; ++r) rest += double(l[q][r]) * x[r];
-    out[q] = total(all) + rest;
-  }
-}
-
-// Forward substitution L y = y; y holds `columns` right-hand sides of n entries. Each block
-// of L is read once for all of them (the loops over right-hand sides are innermost but one).
-void forwardSupernodal(Supernodes& f, int n, int columns) {
-  const int count = static_cast<int>(f.first.size()) - 1;
-  const long stride = f.tallest;
-  for (int k = 0; k < count; ++k) {
-    const int first = f.first[k], width = f.first[k + 1] - first;
-    const int height = f.rowStart[k + 1] - f.rowStart[k], below = height - width;
-    const float* L = f.values.data() + f.valueStart[k];
-    const int* rows = f.rows.data() + f.rowStart[k] + width;
-    const auto own = [&](int c) { return f.y.data() + static_cast<long>(c) * n + first; };
-    const auto work = [&](int c) { return f.work.data() + c * stride; };
-    for (int j = 0; j < width; ++j) {  // the diagonal block's triangle
-      // From a multiple of four (the block's upper triangle and diagonal are stored as zeros):
-      // each step then stores the very vectors the next one loads, which the processor
-      // forwards; shifted by one entry a step, every load would wait for the stores.
-      const int from = j & ~3;
-      const float* column = L + static_cast<long>(j) * height + from;
-      for (int c = 0; c < columns; ++c) {
-        double* y = own(c);
-        y[j] *= f.inverseDiagonal[first + j];
-        const double yj = y[j];
-        subtractColumns<1>(y + from, &column, &yj, width - from);
-      }
-    }
-    for (int c = 0; c < columns; ++c) std::fill_n(work(c), below, 0.0);
-    int j = 0;
-    for (; j + 4 <= width; j += 4) {  // the rows below, four columns at a time
-      const float* l[4];
-      for (int q = 0; q < 4; ++q) l[q] = L + static_cast<long>(j + q) * height + width;
-      for (int c = 0; c < columns; ++c) subtractColumns<4>(work(c), l, own(c) + j, below);
-    }
-    for (; j < width; ++j) {
-      const float* l = L + static_cast<long>(j) * height + width;
-      for (int c = 0; c < columns; ++c) subtractColumns<1>(work(c), &l, own(c) + j, below);
-    }
-    for (int c = 0; c < columns; ++c) {
-      double* y = f.y.data() + static_cast<long>(c) * n;
-      const double* t = work(c);
-      for (int i = 0; i < below; ++i) y[rows[i]] += t[i];  // t holds minus the sums
-    }
-  }
-}
-
-// Backward substitution L' y = y, as forwardSupernodal.
-void backwardSupernodal(Supernodes& f, int n, int columns) {
-  const int count = static_cast<int>(f.first.size()) - 1;
-  const long stride = f.tallest;
-  for (int k = count - 1; k >= 0; --k) {
-    const int first = f.first[k], width = f.first[k + 1] - first;
-    const int height = f.rowStart[k + 1] - f.rowStart[k], below = height - width;
-    const float* L = f.values.data() + f.valueStart[k];
-    const int* rows = f.rows.data() + f.rowStart[k] + width;
-    const auto own = [&](int c) { return f.y.data() + static_cast<long>(c) * n + first; };
-    const auto work = [&](int c) { return f.work.data() + c * stride; };
-    for (int c = 0; c < columns; ++c) {
-      const double* y = f.y.data() + static_cast<long>(c) * n;
-      double* t = work(c);
-      for (int i = 0; i < below; ++i) t[i] = y[rows[i]];
-    }
-    double sums[4];
-    int j = 0;
-    for (; j + 4 <= width; j += 4) {  // the rows below, four columns at a time
-      const float* l[4];
-      for (int q = 0; q < 4; ++q) l[q] = L + static_cast<long>(j + q) * height + width;
-      for (int c = 0; c < columns; ++c) {
-        dotColumns<4>(l, work(c), below, sums);
-        for (int q = 0; q < 4; ++q) own(c)[j + q] -= sums[q];
-      }
-    }
-    for (; j < width; ++j) {
-      const float* l = L + static_cast<long>(j) * height + width;
-      for (int c = 0; c < columns; ++c) {
-        dotColumns<1>(&l, work(c), below, sums);
-        own(c)[j] -= sums[0];
-      }
-    }
-    for (int jj = width - 1; jj >= 0; --jj) {  // the diagonal block's triangle, transposed
-      const int from = jj & ~3;                // as in forwardSupernodal
-      const float* column = L + static_cast<long>(jj) * height + from;
-      for (int c = 0; c < columns; ++c) {
-        double* y = own(c);
-        dotColumns<1>(&column, y + from, width - from, sums);
-        y[jj] = (y[jj] - sums[0]) * f.inverseDiagonal[first + jj];
-      }
-    }
-  }
-}
-
 }  // namespace
 
 // Above this many entries in L the copy and its indices no longer stay in cache, and supernodal
@@ -235,7 +61,7 @@ struct PrefactoredCholesky::Impl {
   cholmod_factor* updated = nullptr;
   bool copied = false;      // solves run over the copy, not through CHOLMOD
   bool singleCopy = false;  // solves run over the single-precision supernodes
-  Supernodes supernodes;
+  SingleSupernodes supernodes;
   std::vector<int> inversePerm;
   std::vector<Lanes> lanes;
   std::vector<double> single;
@@ -337,7 +163,7 @@ StepResult PrefactoredCholesky::factorize(const SparseMatrix& A) {
   const auto* perm = static_cast<const int*>(L->Perm);
   perm_.assign(perm, perm + n);
   if (s.singleCopy) {
-    copySupernodes(*L);
+    s.supernodes.copy(*L, n);
     return StepResult::success();
   }
   if (!s.copied) return StepResult::success();
@@ -364,41 +190,6 @@ StepResult PrefactoredCholesky::factorize(const SparseMatrix& A) {
   }
   transposeCopy();
   return StepResult::success();
-}
-
-void PrefactoredCholesky::copySupernodes(const cholmod_factor& L) {
-  Supernodes& f = impl_->supernodes;
-  const auto count = static_cast<std::size_t>(L.nsuper);
-  const auto* super = static_cast<const int*>(L.super);
-  const auto* pi = static_cast<const int*>(L.pi);
-  const auto* px = static_cast<const int*>(L.px);
-  const auto* rows = static_cast<const int*>(L.s);
-  const auto* values = static_cast<const double*>(L.x);
-  f.first.assign(super, super + count + 1);
-  f.rowStart.assign(pi, pi + count + 1);
-  f.rows.assign(rows, rows + pi[count]);
-  f.valueStart.assign(px, px + count);
-  const long size = px[count];
-  f.values.resize(static_cast<std::size_t>(size));
-  for (long q = 0; q < size; ++q)
-    f.values[static_cast<std::size_t>(q)] = static_cast<float>(values[q]);
-  f.inverseDiagonal.resize(static_cast<std::size_t>(n_));
-  int tallest = 0;
-  for (std::size_t k = 0; k < count; ++k) {
-    const int height = pi[k + 1] - pi[k];
-    tallest = std::max(tallest, height);
-    for (int j = super[k]; j < super[k + 1]; ++j) {
-      const long column = px[k] + static_cast<long>(j - super[k]) * height;
-      const long at = column + (j - super[k]);  // (j, j)
-      f.inverseDiagonal[static_cast<std::size_t>(j)] = 1.0 / values[at];
-      // The diagonal and above read as zeros (the solves run over them; CHOLMOD leaves the
-      // entries above undefined).
-      std::fill(f.values.begin() + column, f.values.begin() + at + 1, 0.0f);
-    }
-  }
-  f.tallest = tallest;
-  f.work.resize(3 * static_cast<std::size_t>(tallest));
-  f.y.resize(3 * static_cast<std::size_t>(n_));
 }
 
 void PrefactoredCholesky::transposeCopy() {
@@ -513,12 +304,11 @@ StepResult PrefactoredCholesky::solve(double* b, int columns) const {
   Impl& s = *impl_;
   const int n = n_;
   if (s.singleCopy && !s.updated) {
-    double* y = s.supernodes.y.data();
+    double* y = s.supernodes.workspace();
     for (int c = 0; c < columns; ++c) {
       for (int k = 0; k < n; ++k) y[c * n + k] = b[c * n + perm_[k]];
     }
-    forwardSupernodal(s.supernodes, n, columns);
-    backwardSupernodal(s.supernodes, n, columns);
+    s.supernodes.solve(columns);
     for (int c = 0; c < columns; ++c) {
       for (int k = 0; k < n; ++k) b[c * n + perm_[k]] = y[c * n + k];
     }

@@ -8,7 +8,8 @@
 //   and no chain of dependent additions limits the loop. Measured at 8^3 (512 points, 42,000
 //   entries in L): a solve for three columns takes about half of CHOLMOD's own supernodal solve.
 // - above (12^3 points and more: the copy and its indices no longer stay in cache), CHOLMOD's
-//   dense supernodes copied in single precision and solved by our own blocked substitutions,
+//   dense supernodes copied in single precision and solved by our own blocked substitutions
+//   (solvers/single_supernodes.h),
 //   every product and sum in double: these solves are bound by memory traffic, which the floats
 //   halve (BM_KeptFactorSolve: 1.7x faster than CHOLMOD's double solve at 16^3 and 32^3). The
 //   answer is that of a factor rounded to single precision (about 1e-7 relative times the
@@ -24,8 +25,6 @@
 
 #include "solvers/jacobian.h"
 #include "solvers/step_result.h"
-
-struct cholmod_factor_struct;  // CHOLMOD's cholmod_factor
 
 namespace jello {
 
@@ -65,7 +64,6 @@ class PrefactoredCholesky {
   std::unique_ptr<Impl> impl_;
   long copyLimit_;
   bool singlePrecision_;
-  void copySupernodes(const cholmod_factor_struct& L);  // the single-precision copy
   StepResult solveByCholmod(double* b, int columns) const;
   void transposeCopy();  // L by rows from L by columns
   int n_ = 0;

@@ -2,7 +2,8 @@
 // time per simulated second at the largest step that keeps the visible motion within a
 // tolerance of a converged reference over the whole window, and stays stable. The scene is a
 // cube thrown sideways and spinning, falling under gravity onto the floor and bouncing (the
-// reference worlds' damping); its visible motion is what an affine map of the cube at rest
+// reference worlds' damping), or the same throw without gravity, touching nothing
+// (AtlasScene); its visible motion is what an affine map of the cube at rest
 // shows: the centre of mass, the rotation and the homogeneous stretch and shear, measured at
 // the cube's eight corners. Part of jello-scaling (its NAME_atlas.csv).
 #pragma once
