@@ -392,11 +392,13 @@ def experiments_runtime():
         text += (" The atlas at " + " and ".join(f"N = {n}" for n, _ in extra) + " took " +
                  " and ".join(f"{t / 60:.0f} min" for _, t in extra) +
                  ", each on one core of the same machine, side by side.")
-    free = sorted((int(rows[0]["n"]), sidecar["wall_time_s"])
+    free = sorted((int(rows[0]["n"]), sidecar["wall_time_s"], sidecar["parameters"]["jobs"])
                   for rows, sidecar in atlas_sources(ATLAS_FREE).values())
     if free:
-        text += (" The free scene's atlas at " + " and ".join(f"N = {n}" for n, _ in free) +
-                 " took " + " and ".join(f"{t / 60:.0f} min" for _, t in free) + " on one core.")
+        text += (" The free scene's atlas at " + " and ".join(f"N = {n}" for n, _, _ in free) +
+                 " took " + " and ".join(
+                     f"{t / 60:.0f} min on {'one core' if j == 1 else f'{j} cores'}"
+                     for _, t, j in free) + ".")
     return text
 
 
