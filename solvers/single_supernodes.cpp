@@ -96,17 +96,32 @@ void forward(SingleSupernodes::Data& f, int n, int columns) {
     const int* rows = f.rows.data() + f.rowStart[k] + width;
     const auto own = [&](int c) { return f.y.data() + static_cast<long>(c) * n + first; };
     const auto work = [&](int c) { return f.work.data() + c * stride; };
-    for (int j = 0; j < width; ++j) {  // the diagonal block's triangle
-      // From a multiple of four (the block's upper triangle and diagonal are stored as zeros):
-      // each step then stores the very vectors the next one loads, which the processor
-      // forwards; shifted by one entry a step, every load would wait for the stores.
-      const int from = j & ~3;
-      const float* column = L + static_cast<long>(j) * height + from;
+    // The diagonal block's triangle, in panels of four columns: each panel's own 4 x 4
+    // triangle entry by entry, then the block's rows below it four columns at a time (one load
+    // and store of y for four columns). Measured against one column at a time: the whole solve
+    // 5% faster at 16^3 (about 0.95 against 1.0 ms), 10% at 32^3 (25 against 28 ms).
+    int panel = 0;
+    for (; panel + 4 <= width; panel += 4) {
+      for (int q = 0; q < 4; ++q) {
+        const float* column = L + static_cast<long>(panel + q) * height;
+        for (int c = 0; c < columns; ++c) {
+          double* y = own(c);
+          y[panel + q] *= f.inverseDiagonal[first + panel + q];
+          for (int r = q + 1; r < 4; ++r) y[panel + r] -= double(column[panel + r]) * y[panel + q];
+        }
+      }
+      const float* l[4];
+      for (int q = 0; q < 4; ++q) l[q] = L + static_cast<long>(panel + q) * height + panel + 4;
+      for (int c = 0; c < columns; ++c) {
+        subtractColumns<4>(own(c) + panel + 4, l, own(c) + panel, width - panel - 4);
+      }
+    }
+    for (int j = panel; j < width; ++j) {  // the last columns, fewer than four
+      const float* column = L + static_cast<long>(j) * height;
       for (int c = 0; c < columns; ++c) {
         double* y = own(c);
         y[j] *= f.inverseDiagonal[first + j];
-        const double yj = y[j];
-        subtractColumns<1>(y + from, &column, &yj, width - from);
+        for (int r = j + 1; r < width; ++r) y[r] -= double(column[r]) * y[j];
       }
     }
     for (int c = 0; c < columns; ++c) std::fill_n(work(c), below, 0.0);
@@ -161,13 +176,31 @@ void backward(SingleSupernodes::Data& f, int n, int columns) {
         own(c)[j] -= sums[0];
       }
     }
-    for (int jj = width - 1; jj >= 0; --jj) {  // the diagonal block's triangle, transposed
-      const int from = jj & ~3;                // as in forwardSupernodal
-      const float* column = L + static_cast<long>(jj) * height + from;
+    // The diagonal block's triangle, transposed, in forward's panels from the last: the last
+    // columns (fewer than four) one by one, then each panel's dot products with the rows below
+    // it four columns at a time and its own 4 x 4 triangle.
+    const int panels = width & ~3;
+    for (int jj = width - 1; jj >= panels; --jj) {
+      const float* column = L + static_cast<long>(jj) * height;
       for (int c = 0; c < columns; ++c) {
         double* y = own(c);
-        dotColumns<1>(&column, y + from, width - from, sums);
-        y[jj] = (y[jj] - sums[0]) * f.inverseDiagonal[first + jj];
+        double sum = y[jj];
+        for (int r = jj + 1; r < width; ++r) sum -= double(column[r]) * y[r];
+        y[jj] = sum * f.inverseDiagonal[first + jj];
+      }
+    }
+    for (int panel = panels - 4; panel >= 0; panel -= 4) {
+      const float* l[4];
+      for (int q = 0; q < 4; ++q) l[q] = L + static_cast<long>(panel + q) * height + panel + 4;
+      for (int c = 0; c < columns; ++c) {
+        double* y = own(c);
+        dotColumns<4>(l, y + panel + 4, width - panel - 4, sums);
+        for (int q = 3; q >= 0; --q) {
+          const float* column = L + static_cast<long>(panel + q) * height;
+          double sum = y[panel + q] - sums[q];
+          for (int r = q + 1; r < 4; ++r) sum -= double(column[panel + r]) * y[panel + r];
+          y[panel + q] = sum * f.inverseDiagonal[first + panel + q];
+        }
       }
     }
   }
