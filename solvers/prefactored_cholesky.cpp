@@ -51,8 +51,8 @@ void substitute(int n, const std::vector<int>& rowStart, const std::vector<int>&
 // solves (dense blocks) win: measured over three right-hand sides at 512, 1,000, 1,728 and 4,096
 // points (L of 48,000, 139,000, 340,000 and 1.1 million entries), the copy solved in 0.45, 0.65,
 // 0.8 and 1.6 times CHOLMOD's time (kDefaultCopyLimit); the single-precision supernodes in 0.65,
-// -, 0.6 and 0.6 (BM_KeptFactorSolve: 50, 307 and 975 us at 8^3, 12^3, 16^3 against the copy's
-// 33, 287 and 2,100).
+// -, 0.6 and 0.5 (BM_KeptFactorSolve: 50, 305 and 953 us at 8^3, 12^3, 16^3 against the copy's
+// 34, 297 and 2,230).
 struct PrefactoredCholesky::Impl {
   cholmod_common common{};
   cholmod_factor* symbolic = nullptr;  // analysis of the pattern, factored in place

@@ -11,7 +11,7 @@
 //   dense supernodes copied in single precision and solved by our own blocked substitutions
 //   (solvers/single_supernodes.h),
 //   every product and sum in double: these solves are bound by memory traffic, which the floats
-//   halve (BM_KeptFactorSolve: 1.7x faster than CHOLMOD's double solve at 16^3 and 32^3). The
+//   halve (BM_KeptFactorSolve: about twice as fast as CHOLMOD's double solve at 16^3 to 32^3). The
 //   answer is that of a factor rounded to single precision (about 1e-7 relative times the
 //   condition number): what a preconditioner or projective's fixed-point iterations need, whose
 //   residuals are evaluated in double. singlePrecision = false solves these by CHOLMOD.
