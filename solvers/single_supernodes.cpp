@@ -234,8 +234,8 @@ void SingleSupernodes::copy(const cholmod_factor& L, int n) {
       const long column = px[k] + static_cast<long>(j - super[k]) * height;
       const long at = column + (j - super[k]);  // (j, j)
       f.inverseDiagonal[static_cast<std::size_t>(j)] = 1.0 / values[at];
-      // The diagonal and above read as zeros (the solves run over them; CHOLMOD leaves the
-      // entries above undefined).
+      // The diagonal and above as zeros: the solves never read them (the diagonal's inverse is
+      // kept in double), and CHOLMOD leaves the entries above undefined.
       std::fill(f.values.begin() + column, f.values.begin() + at + 1, 0.0f);
     }
   }
