@@ -39,7 +39,9 @@ void midpointForm(const State& s, double h, ImplicitStepForm& f) {
 }  // namespace
 
 NewtonIntegrator::NewtonIntegrator(const ImplicitOptions& options)
-    : options_(options), system_(options.linearSolverOptions(), options.clampCompression) {}
+    : options_(options),
+      system_(options.linearSolverOptions(), options.clampCompression),
+      seedWeights_(options.seedChebyshevRho, kSeedChebyshevDelay) {}
 
 void NewtonIntegrator::bind(const Model& model) {
   const bool rebinding = system_.bound();
@@ -98,10 +100,7 @@ StepResult NewtonIntegrator::seed(const Model& model, double inertia, double h) 
   const auto [a, b] = matrixCoefficients(h);
   if (StepResult res = system_.factorProjective(a, b); !res.ok) return res;
   const double scale = -h * h / form_.gamma;
-  // Chebyshev (ProjectiveOptions::chebyshevRho): omega 1 while plain.
-  const double rho = options_.seedChebyshevRho;
-  double omega = 1.0, firstResidual = 0.0;
-  int plainSince = 0;
+  seedWeights_.start();  // ImplicitOptions::seedChebyshevRho
   for (int k = 0; k < options_.seedIterations; ++k) {
     if (interruptRequested()) return StepResult::interruption();
     evaluate(model, inertia, d_);  // x_e of d_ into xe_
@@ -110,23 +109,11 @@ StepResult NewtonIntegrator::seed(const Model& model, double inertia, double h) 
     delta_ = scale * r_;
     if (StepResult res = system_.solveProjective(delta_); !res.ok) return res;
     ++seeds_;
-    if (rho <= 0.0) {
+    if (options_.seedChebyshevRho <= 0.0) {
       d_ += delta_;
       continue;
     }
-    const int plain = k - plainSince;
-    if (plain == 0) firstResidual = lastResidual_;
-    if (omega != 1.0 && lastResidual_ > firstResidual) {
-      // Grown beyond the run's first: the plain update, and the count starts again.
-      omega = 1.0;
-      plainSince = k;
-      firstResidual = lastResidual_;
-      ++seedRestarts_;
-    } else if (plain == kSeedChebyshevDelay) {
-      omega = 2.0 / (2.0 - rho * rho);
-    } else if (plain > kSeedChebyshevDelay) {
-      omega = 4.0 / (4.0 - rho * rho * omega);
-    }
+    const double omega = seedWeights_.next(lastResidual_);
     if (omega == 1.0) {
       previousSeed_ = d_;
       d_ += delta_;
@@ -262,7 +249,7 @@ std::vector<Statistic> NewtonIntegrator::statistics() const {
       {"line_search_failures", static_cast<double>(searchFailures_)},
       {"factor_reuses", static_cast<double>(reuses_)},
       {"seed_iterations", static_cast<double>(seeds_)},
-      {"seed_chebyshev_restarts", static_cast<double>(seedRestarts_)},
+      {"seed_chebyshev_restarts", static_cast<double>(seedWeights_.restarts())},
   };
   system_.appendStatistics(stats);
   return stats;

@@ -51,6 +51,7 @@
 #include <memory>
 #include <utility>
 
+#include "solvers/chebyshev_weights.h"
 #include "solvers/implicit_system.h"
 #include "solvers/integrator.h"
 
@@ -119,7 +120,8 @@ class NewtonIntegrator : public Integrator {
   double lastResidual_ = 0.0;
   bool lastConverged_ = true;
   long steps_ = 0, iterations_ = 0, maxIterations_ = 0, cuts_ = 0, searchFailures_ = 0,
-       unconverged_ = 0, reuses_ = 0, seeds_ = 0, seedRestarts_ = 0;
+       unconverged_ = 0, reuses_ = 0, seeds_ = 0;
+  ChebyshevWeights seedWeights_;  // the seed iterations' (ImplicitOptions::seedChebyshevRho)
 };
 
 // The four methods state only their forms; construction is the base's (ImplicitOptions or

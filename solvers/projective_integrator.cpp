@@ -32,7 +32,9 @@ struct ProjectiveIntegrator::Factors {
 };
 
 ProjectiveIntegrator::ProjectiveIntegrator(const ProjectiveOptions& options)
-    : options_(options), factors_(std::make_unique<Factors>()) {}
+    : options_(options),
+      chebyshev_(options.chebyshevRho, options.chebyshevDelay),
+      factors_(std::make_unique<Factors>()) {}
 
 ProjectiveIntegrator::~ProjectiveIntegrator() = default;
 
@@ -126,11 +128,7 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
   y_ = s.x + h * s.v;
   x_ = y_;
   int iterations = 0;
-  // Chebyshev: omega 1 while plain (ProjectiveOptions::chebyshevRho).
-  const double rho = options_.chebyshevRho;
-  const int delay = std::max(1, options_.chebyshevDelay);
-  double omega = 1.0, firstNorm = 0.0;
-  int plainSince = 0;  // the iteration the plain run (start or restart) began at
+  chebyshev_.start();  // ProjectiveOptions::chebyshevRho
   for (; iterations < options_.iterations; ++iterations) {
     if (interruptRequested()) return StepResult::interruption();  // s is still the start
     // Local step inside the force evaluation; damping, field and user force at the iterate.
@@ -159,26 +157,12 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
     if (!solved.ok) return solved;
     solveSeconds_ += secondsSince(start);
     double update;
-    if (rho <= 0.0) {
+    if (options_.chebyshevRho <= 0.0) {
       Eigen::Map<Eigen::MatrixXd>(x_.data(), n, 3) += delta_;
       update = delta_.cwiseAbs().maxCoeff();
     } else {
-      const double norm = delta_.norm();
-      const int plain = iterations - plainSince;  // iterations since the plain run began
-      if (plain == 0) firstNorm = norm;
-      if ((contactChanged && plain > 0) || (omega != 1.0 && norm > firstNorm)) {
-        // A new contact set (a new iteration matrix), or an update grown beyond the run's first
-        // (the nonlinearity moved the spectrum past rho): this update is taken plain and the
-        // count starts again.
-        omega = 1.0;
-        plainSince = iterations;
-        firstNorm = norm;
-        ++chebyshevRestarts_;
-      } else if (plain == delay) {
-        omega = 2.0 / (2.0 - rho * rho);
-      } else if (plain > delay) {
-        omega = 4.0 / (4.0 - rho * rho * omega);
-      }
+      // A new contact set is a new iteration matrix: the Chebyshev run starts again.
+      const double omega = chebyshev_.next(delta_.norm(), contactChanged);
       auto x = Eigen::Map<Eigen::MatrixXd>(x_.data(), n, 3);
       if (omega != 1.0) {
         // x_next = omega (x + delta - previous) + previous; delta becomes x_next - x.
@@ -214,7 +198,7 @@ std::vector<Statistic> ProjectiveIntegrator::statistics() const {
       {"contact_set_changes", static_cast<double>(contactChanges_)},
       {"factor_updates", static_cast<double>(updates_)},
       {"factor_time_s", factorSeconds_},
-      {"chebyshev_restarts", static_cast<double>(chebyshevRestarts_)},
+      {"chebyshev_restarts", static_cast<double>(chebyshev_.restarts())},
       {"solve_time_s", solveSeconds_},
   };
 }

@@ -33,6 +33,7 @@
 #include <utility>
 #include <vector>
 
+#include "solvers/chebyshev_weights.h"
 #include "solvers/integrator.h"
 #include "solvers/jacobian.h"
 
@@ -63,6 +64,7 @@ class ProjectiveIntegrator final : public Integrator {
   StepResult factorChanged(double h);
 
   ProjectiveOptions options_;
+  ChebyshevWeights chebyshev_;
   long modelId_ = -1;
   int n_ = 0;
   double mass_ = 0.0;
@@ -80,7 +82,6 @@ class ProjectiveIntegrator final : public Integrator {
   double lastUpdate_ = 0.0;
   std::vector<std::pair<int, double>> changes_;  // a coordinate's changed contact weights
   long steps_ = 0, iterations_ = 0, factorizations_ = 0, contactChanges_ = 0, updates_ = 0;
-  long chebyshevRestarts_ = 0;
   double factorSeconds_ = 0.0, solveSeconds_ = 0.0;
 };
 
