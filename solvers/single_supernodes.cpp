@@ -84,16 +84,32 @@ void dotColumns(const float* const* l, const double* x, int count, double* out) 
   }
 }
 
+// Supernode k of the copy: its first column, its width (columns), its height (rows, its own
+// columns first), the rows below its own, its dense column-major block and the row indices of
+// the rows below.
+struct Block {
+  int first, width, height, below;
+  const float* L;
+  const int* rows;
+};
+Block block(const SingleSupernodes::Data& f, int k) {
+  const int first = f.first[k], width = f.first[k + 1] - first;
+  const int height = f.rowStart[k + 1] - f.rowStart[k];
+  return {first,
+          width,
+          height,
+          height - width,
+          f.values.data() + f.valueStart[k],
+          f.rows.data() + f.rowStart[k] + width};
+}
+
 // Forward substitution L y = y; y holds `columns` right-hand sides of n entries. Each block
 // of L is read once for all of them (the loops over right-hand sides are innermost but one).
 void forward(SingleSupernodes::Data& f, int n, int columns) {
   const int count = static_cast<int>(f.first.size()) - 1;
   const long stride = f.tallest;
   for (int k = 0; k < count; ++k) {
-    const int first = f.first[k], width = f.first[k + 1] - first;
-    const int height = f.rowStart[k + 1] - f.rowStart[k], below = height - width;
-    const float* L = f.values.data() + f.valueStart[k];
-    const int* rows = f.rows.data() + f.rowStart[k] + width;
+    const auto [first, width, height, below, L, rows] = block(f, k);
     const auto own = [&](int c) { return f.y.data() + static_cast<long>(c) * n + first; };
     const auto work = [&](int c) { return f.work.data() + c * stride; };
     // The diagonal block's triangle, in panels of four columns: each panel's own 4 x 4
@@ -148,10 +164,7 @@ void backward(SingleSupernodes::Data& f, int n, int columns) {
   const int count = static_cast<int>(f.first.size()) - 1;
   const long stride = f.tallest;
   for (int k = count - 1; k >= 0; --k) {
-    const int first = f.first[k], width = f.first[k + 1] - first;
-    const int height = f.rowStart[k + 1] - f.rowStart[k], below = height - width;
-    const float* L = f.values.data() + f.valueStart[k];
-    const int* rows = f.rows.data() + f.rowStart[k] + width;
+    const auto [first, width, height, below, L, rows] = block(f, k);
     const auto own = [&](int c) { return f.y.data() + static_cast<long>(c) * n + first; };
     const auto work = [&](int c) { return f.work.data() + c * stride; };
     for (int c = 0; c < columns; ++c) {
