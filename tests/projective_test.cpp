@@ -68,6 +68,14 @@ State throughAWall(const World& w) {
   return start;
 }
 
+// jello.w through a wall (throughAWall) and backward Euler's step from there, h = 0.01.
+struct ThroughAWallStep {
+  World w = test::loadWorld("jello.w");
+  Model model{w};
+  State start = throughAWall(w);
+  State be = backwardEulerStep(model, start, 0.01);
+};
+
 TEST(Projective, ConvergesToTheBackwardEulerStepAsIterationsGrow) {
   for (double damping : {0.0, 0.25}) {
     SCOPED_TRACE("damping " + std::to_string(damping));
@@ -139,10 +147,9 @@ TEST(Projective, ChebyshevReachesTheBackwardEulerStepInFewerIterations) {
 // Through contact (the walls and the plane, contact damping): Chebyshev converges to the same
 // backward-Euler step.
 TEST(Projective, ChebyshevConvergesThroughContact) {
-  const World w = test::loadWorld("jello.w");
-  const Model model(w);
-  const State start = throughAWall(w);
-  const State be = backwardEulerStep(model, start, 0.01);
+  const ThroughAWallStep step;
+  const Model& model = step.model;
+  const State &start = step.start, &be = step.be;
   const double plain = relativeStepError(start, be, projectiveStep(model, start, 0.01, 30));
   const double fast = relativeStepError(start, be, projectiveStep(model, start, 0.01, 30, 0.85));
   std::printf("jello.w through a wall, 30 iterations: plain %.3g, Chebyshev %.3g\n", plain, fast);
@@ -153,10 +160,9 @@ TEST(Projective, ChebyshevConvergesThroughContact) {
 TEST(Projective, ConvergesToTheBackwardEulerStepThroughContact) {
   // jello.w's deformed cube against the walls and the plane, with damping and contact damping:
   // the fixed point is backward Euler's with every effect where it evaluates them.
-  const World w = test::loadWorld("jello.w");
-  const Model model(w);
-  const State start = throughAWall(w);
-  const State be = backwardEulerStep(model, start, 0.01);
+  const ThroughAWallStep step;
+  const Model& model = step.model;
+  const State &start = step.start, &be = step.be;
   const double e = relativeStepError(start, be, projectiveStep(model, start, 0.01, 300));
   EXPECT_LE(e, 1e-7);
 }
