@@ -19,6 +19,7 @@
 #include "experiments/common/progress.h"
 #include "experiments/common/signal_handler.h"
 #include "experiments/tools/output_check.h"
+#include "experiments/tools/solver_flags.h"
 #include "solvers/modes.h"
 #include "solvers/simulation.h"
 #include "solvers/solver_threads.h"
@@ -57,13 +58,7 @@ struct Options {
   bool outGiven = false, traceGiven = false, statsGiven = false;  // even as an empty string
   long every = 100;
   bool quiet = false;
-  jello::SolverOptions solver;
-  std::string linearSolver;  // empty: SolverOptions' defaults
-  std::string preconditioner = "jacobi";
-  bool csrProduct = false;
-  bool noClamp = false, noStabLimDet = false, noFactorReuse = false;
-  std::string cvodeMethod = "bdf";
-  double atol = 0.0;
+  jello::SolverOptions solver;  // from the solver flags (solver_flags.h)
   jello::ReaderLimits limits;
 };
 
@@ -342,137 +337,8 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->group("Limits (checked before memory is allocated)");
 
-  auto& implicit = opt.solver.implicit;
-  auto& cvode = opt.solver.cvode;
-  const char* implicitGroup =
-      "Implicit solvers (implicit, midpoint, newmark, bdf2, implicit-linear, cvode)";
-  app.add_option("--linear-solver", opt.linearSolver,
-                 "cg (preconditioned, warm-started, matrix-free; the default), cholmod "
-                 "(supernodal LLT) or ldlt")
-      ->check(CLI::IsMember({"cholmod", "ldlt", "cg"}))
-      ->group(implicitGroup);
-  app.add_option("--preconditioner", opt.preconditioner,
-                 "cg: jacobi, block-jacobi (each point's 3x3 block), ichol (incomplete "
-                 "Cholesky), factor (a CHOLMOD factor of an earlier matrix, refreshed when CG "
-                 "needs more than 10 iterations) or projective (the springs' Laplacian "
-                 "M + L(a c + b k) with the contacts on its diagonal, factored once per step "
-                 "size and contact set)")
-      ->check(CLI::IsMember({"jacobi", "block-jacobi", "ichol", "factor", "projective"}))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_flag("--csr-product", opt.csrProduct,
-               "cg: multiply by the sparse matrix instead of through the spring kernels")
-      ->group(implicitGroup);
-  app.add_flag("--no-clamp", opt.noClamp,
-               "Do not clamp compressed springs' Jacobians (the system may be indefinite)")
-      ->group(implicitGroup);
-  app.add_option("--cg-tol", implicit.cgTolerance, "Relative residual of CG solves")
-      ->check(jello::cli::positive())
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--newton-iters", implicit.newtonMaxIterations,
-                 "implicit, midpoint, newmark, bdf2: most Newton iterations per step (a step "
-                 "still unconverged is counted and reported)")
-      ->check(jello::cli::range(1, 1000))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--newton-tol", implicit.newtonTolerance,
-                 "implicit, midpoint, newmark, bdf2: relative residual that ends the iterations")
-      ->check(jello::cli::positive())
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--newton-xtol", implicit.newtonPositionTolerance,
-                 "implicit, midpoint, newmark, bdf2: a Newton update moving no coordinate more "
-                 "than this (m) also ends them")
-      ->check(jello::cli::positive())
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_flag("--no-factor-reuse", opt.noFactorReuse,
-               "implicit, midpoint, newmark, bdf2: factor the Newton matrix at every iteration "
-               "(plain Newton) instead of keeping it while it converges fast enough")
-      ->group(implicitGroup);
-  app.add_option("--refactor-ratio", implicit.refactorRatio,
-                 "implicit, midpoint, newmark, bdf2: factor afresh when an iteration shrinks "
-                 "the residual by less than this")
-      ->check(jello::cli::range(1e-6, 1.0))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--newton-seed", implicit.seedIterations,
-                 "implicit, midpoint, newmark, bdf2: iterations with the constant projective "
-                 "matrix before Newton (stopped at the first iterate in contact; 0: none)")
-      ->check(jello::cli::range(0, 1000))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--newton-seed-tol", implicit.seedTolerance,
-                 "implicit, midpoint, newmark, bdf2: relative residual that ends the seed "
-                 "iterations (at or below --newton-tol they may converge the step themselves)")
-      ->check(jello::cli::positive())
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--newton-seed-chebyshev", implicit.seedChebyshevRho,
-                 "implicit, midpoint, newmark, bdf2: Chebyshev acceleration of the seed "
-                 "iterations with this rho, as --projective-chebyshev (0: off; 0.9 measured "
-                 "best with --newton-seed-tol 1e-8)")
-      ->check(jello::cli::range(0.0, 0.999))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  auto& projective = opt.solver.projective;
-  app.add_option("--projective-iters", projective.iterations,
-                 "projective: local/global iterations per step")
-      ->check(jello::cli::range(1, 100000))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--projective-tol", projective.tolerance,
-                 "projective: stop a step's iterations early once an update moves no coordinate "
-                 "more than this (m; 0: never early)")
-      ->check(jello::cli::nonNegative())
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--projective-chebyshev", projective.chebyshevRho,
-                 "projective: Chebyshev acceleration of the iterations (Wang 2015) with this "
-                 "assumed contraction rho, after 2 plain iterations (0: off; 0.85 measured best "
-                 "on the spinning stiff cube)")
-      ->check(jello::cli::range(0.0, 0.999))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--rtol", cvode.rtol, "cvode: relative tolerance")
-      ->check(jello::cli::positive())
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--cvode-method", opt.cvodeMethod,
-                 "cvode: bdf (stiff: Newton over the implicit system) or adams (non-stiff: "
-                 "fixed-point iterations, no linear algebra)")
-      ->check(CLI::IsMember({"bdf", "adams"}))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--atol", opt.atol,
-                 "cvode: absolute tolerance of positions (m) and velocities (m/s) (default "
-                 "1e-3 * rtol)")
-      ->check(jello::cli::positive())
-      ->group(implicitGroup);
-  app.add_option("--atol-x", cvode.atolPosition, "cvode: absolute tolerance of positions (m)")
-      ->check(jello::cli::positive())
-      ->group(implicitGroup);
-  app.add_option("--atol-v", cvode.atolVelocity, "cvode: absolute tolerance of velocities (m/s)")
-      ->check(jello::cli::positive())
-      ->group(implicitGroup);
-  app.add_flag("--cvode-krylov", cvode.krylov,
-               "cvode (bdf): solve Newton's systems by SPGMR, matrix-free, preconditioned by "
-               "the reduced system (--linear-solver), its factor kept between setups")
-      ->group(implicitGroup);
-  app.add_flag("--contact-roots", cvode.contactRoots,
-               "cvode: locate contact onset and release as roots and restart there")
-      ->group(implicitGroup);
-  app.add_option("--max-order", cvode.maxOrder, "cvode: largest BDF order")
-      ->check(jello::cli::range(1, 5))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_flag("--no-stab-lim-det", opt.noStabLimDet,
-               "cvode: switch off BDF stability-limit detection")
-      ->group(implicitGroup);
-  app.add_option("--max-step", cvode.maxStep, "cvode: largest internal step, s (default none)")
-      ->check(jello::cli::positive())
-      ->group(implicitGroup);
+  jello::SolverFlags solverFlags;
+  jello::addSolverFlags(app, solverFlags);
   try {
     app.parse(argc, argv);
     jello::refuseNonFiniteNumbers(app);
@@ -480,26 +346,9 @@ int main(int argc, char** argv) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : kExitUsage;
   }
-  if (!opt.linearSolver.empty()) {
-    const auto linear = *jello::parseLinearSolver(opt.linearSolver);
-    opt.solver.implicit.linearSolver = opt.solver.cvode.linearSolver = linear;
-  }
-  opt.solver.implicit.preconditioner = opt.solver.cvode.preconditioner =
-      *jello::parsePreconditioner(opt.preconditioner);
-  opt.solver.implicit.matrixFree = opt.solver.cvode.matrixFree = !opt.csrProduct;
-  opt.solver.implicit.clampCompression = opt.solver.cvode.clampCompression = !opt.noClamp;
-  opt.solver.cvode.cgTolerance = opt.solver.implicit.cgTolerance;
-  opt.solver.cvode.stabilityLimitDetection = !opt.noStabLimDet;
-  opt.solver.implicit.reuseFactor = !opt.noFactorReuse;
+  opt.solver = jello::solverOptions(solverFlags);
   opt.outGiven = app.count("--out") > 0;
   opt.statsGiven = app.count("--stats") > 0;
   opt.traceGiven = app.count("--trace") > 0;
-  opt.solver.cvode.method =
-      opt.cvodeMethod == "adams" ? jello::CvodeMethod::Adams : jello::CvodeMethod::Bdf;
-  // --atol sets both; --atol-x and --atol-v win over it.
-  if (opt.atol > 0.0) {
-    if (opt.solver.cvode.atolPosition == 0.0) opt.solver.cvode.atolPosition = opt.atol;
-    if (opt.solver.cvode.atolVelocity == 0.0) opt.solver.cvode.atolVelocity = opt.atol;
-  }
   return run(opt);
 }
