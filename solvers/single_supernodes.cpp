@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include "src/assertions.h"
+
 namespace jello {
 namespace {
 
@@ -42,46 +44,65 @@ inline double total(Doubles4 v) {
   return (v[0] + v[1]) + (v[2] + v[3]);
 }
 
-// y[i] -= sum over the q < B columns of l[q][i] a[q], i < count.
-template <int B>
-void subtractColumns(double* y, const float* const* l, const double* a, int count) {
+// The kernels below take the C <= 3 right-hand sides side by side: each float of L is widened
+// once for all of them (one at a time, the conversions were half the solve at 16^3).
+
+// y[c][i] -= sum over the q < B columns of l[q][i] a[c][q], i < count, for c < C.
+template <int B, int C>
+void subtractColumns(double* const* y, const float* const* l, const double* const* a, int count) {
   int i = 0;
   for (; i + 4 <= count; i += 4) {
-    Doubles4 sum = widen(l[0] + i) * a[0];
-    for (int q = 1; q < B; ++q) sum += widen(l[q] + i) * a[q];
-    store(y + i, load(y + i) - sum);
+    Doubles4 sum[C];
+    {
+      const Doubles4 li = widen(l[0] + i);
+      for (int c = 0; c < C; ++c) sum[c] = li * a[c][0];
+    }
+    for (int q = 1; q < B; ++q) {
+      const Doubles4 li = widen(l[q] + i);
+      for (int c = 0; c < C; ++c) sum[c] += li * a[c][q];
+    }
+    for (int c = 0; c < C; ++c) store(y[c] + i, load(y[c] + i) - sum[c]);
   }
   for (; i < count; ++i) {
-    double sum = 0.0;
-    for (int q = 0; q < B; ++q) sum += double(l[q][i]) * a[q];
-    y[i] -= sum;
+    for (int c = 0; c < C; ++c) {
+      double sum = 0.0;
+      for (int q = 0; q < B; ++q) sum += double(l[q][i]) * a[c][q];
+      y[c][i] -= sum;
+    }
   }
 }
 
-// out[q] = sum over i < count of l[q][i] x[i], for the q < B columns. One column runs over four
-// accumulators: a single one would wait on the adder's latency at every step.
-template <int B>
-void dotColumns(const float* const* l, const double* x, int count, double* out) {
-  constexpr int kChains = B == 1 ? 4 : 1;
-  Doubles4 sum[B][kChains] = {};
+// out[c][q] = sum over i < count of l[q][i] x[c][i], for the q < B columns and c < C. Few
+// products run over several accumulators: one alone would wait on the adder's latency.
+template <int B, int C>
+void dotColumns(const float* const* l, const double* const* x, int count, double (*out)[4]) {
+  constexpr int kChains = B * C >= 4 ? 1 : (B * C == 1 ? 4 : 2);
+  Doubles4 sum[C][B][kChains] = {};
   int i = 0;
   for (; i + 4 * kChains <= count; i += 4 * kChains) {
     for (int u = 0; u < kChains; ++u) {
-      const Doubles4 xi = load(x + i + 4 * u);
-      for (int q = 0; q < B; ++q) sum[q][u] += widen(l[q] + i + 4 * u) * xi;
+      Doubles4 xi[C];
+      for (int c = 0; c < C; ++c) xi[c] = load(x[c] + i + 4 * u);
+      for (int q = 0; q < B; ++q) {
+        const Doubles4 li = widen(l[q] + i + 4 * u);
+        for (int c = 0; c < C; ++c) sum[c][q][u] += li * xi[c];
+      }
     }
   }
   for (; i + 4 <= count; i += 4) {
-    const Doubles4 xi = load(x + i);
-    for (int q = 0; q < B; ++q) sum[q][0] += widen(l[q] + i) * xi;
+    for (int q = 0; q < B; ++q) {
+      const Doubles4 li = widen(l[q] + i);
+      for (int c = 0; c < C; ++c) sum[c][q][0] += li * load(x[c] + i);
+    }
   }
-  for (int q = 0; q < B; ++q) {
-    Doubles4 all = sum[q][0];
-    for (int u = 1; u < kChains; ++u) all += sum[q][u];
-    double rest = 0.0;
-    for (int r = i; r < count; ++r) rest += double(l[q][r]) * x[r];
-    out[q] = total(all) + rest;
-  }
+  for (int c = 0; c < C; ++c)
+    for (int q = 0; q < B; ++q) {
+      Doubles4 all = sum[c][q][0];
+      for (int u = 1; u < kChains; ++u) all += sum[c][q][u];
+      double rest = 0.0;
+      for (int r = i; r < count; ++r) rest += double(l[q][r]) * x[c][r];
+      out[c][q] = total(all) + rest;
+    }
 }
 
 // Supernode k of the copy: its first column, its width (columns), its height (rows, its own
@@ -103,15 +124,31 @@ Block block(const SingleSupernodes::Data& f, int k) {
           f.rows.data() + f.rowStart[k] + width};
 }
 
-// Forward substitution L y = y; y holds `columns` right-hand sides of n entries. Each block
-// of L is read once for all of them (the loops over right-hand sides are innermost but one).
-void forward(SingleSupernodes::Data& f, int n, int columns) {
+// The C right-hand sides' pointers, each offset by `offset` from `base` (C of them, `stride`
+// apart).
+template <int C>
+struct Columns {
+  double* at[C];
+  Columns(double* base, long stride, long offset) {
+    for (int c = 0; c < C; ++c) at[c] = base + c * stride + offset;
+  }
+  Columns shifted(long by) const {
+    Columns moved = *this;
+    for (double*& p : moved.at) p += by;
+    return moved;
+  }
+};
+
+// Forward substitution L y = y; y holds C right-hand sides of n entries. Each block of L is
+// read once for all of them.
+template <int C>
+void forward(SingleSupernodes::Data& f, int n) {
   const int count = static_cast<int>(f.first.size()) - 1;
   const long stride = f.tallest;
+  const Columns<C> work(f.work.data(), stride, 0);
   for (int k = 0; k < count; ++k) {
     const auto [first, width, height, below, L, rows] = block(f, k);
-    const auto own = [&](int c) { return f.y.data() + static_cast<long>(c) * n + first; };
-    const auto work = [&](int c) { return f.work.data() + c * stride; };
+    const Columns<C> own(f.y.data(), n, first);
     // The diagonal block's triangle, in panels of four columns: each panel's own 4 x 4
     // triangle entry by entry, then the block's rows below it four columns at a time (one load
     // and store of y for four columns). Measured against one column at a time: the whole solve
@@ -120,74 +157,68 @@ void forward(SingleSupernodes::Data& f, int n, int columns) {
     for (; panel + 4 <= width; panel += 4) {
       for (int q = 0; q < 4; ++q) {
         const float* column = L + static_cast<long>(panel + q) * height;
-        for (int c = 0; c < columns; ++c) {
-          double* y = own(c);
+        for (double* y : own.at) {
           y[panel + q] *= f.inverseDiagonal[first + panel + q];
           for (int r = q + 1; r < 4; ++r) y[panel + r] -= double(column[panel + r]) * y[panel + q];
         }
       }
       const float* l[4];
       for (int q = 0; q < 4; ++q) l[q] = L + static_cast<long>(panel + q) * height + panel + 4;
-      for (int c = 0; c < columns; ++c) {
-        subtractColumns<4>(own(c) + panel + 4, l, own(c) + panel, width - panel - 4);
-      }
+      subtractColumns<4, C>(own.shifted(panel + 4).at, l, own.shifted(panel).at, width - panel - 4);
     }
     for (int j = panel; j < width; ++j) {  // the last columns, fewer than four
       const float* column = L + static_cast<long>(j) * height;
-      for (int c = 0; c < columns; ++c) {
-        double* y = own(c);
+      for (double* y : own.at) {
         y[j] *= f.inverseDiagonal[first + j];
         for (int r = j + 1; r < width; ++r) y[r] -= double(column[r]) * y[j];
       }
     }
-    for (int c = 0; c < columns; ++c) std::fill_n(work(c), below, 0.0);
+    for (double* t : work.at) std::fill_n(t, below, 0.0);
     int j = 0;
     for (; j + 4 <= width; j += 4) {  // the rows below, four columns at a time
       const float* l[4];
       for (int q = 0; q < 4; ++q) l[q] = L + static_cast<long>(j + q) * height + width;
-      for (int c = 0; c < columns; ++c) subtractColumns<4>(work(c), l, own(c) + j, below);
+      subtractColumns<4, C>(work.at, l, own.shifted(j).at, below);
     }
     for (; j < width; ++j) {
       const float* l = L + static_cast<long>(j) * height + width;
-      for (int c = 0; c < columns; ++c) subtractColumns<1>(work(c), &l, own(c) + j, below);
+      subtractColumns<1, C>(work.at, &l, own.shifted(j).at, below);
     }
-    for (int c = 0; c < columns; ++c) {
+    for (int c = 0; c < C; ++c) {
       double* y = f.y.data() + static_cast<long>(c) * n;
-      const double* t = work(c);
+      const double* t = work.at[c];
       for (int i = 0; i < below; ++i) y[rows[i]] += t[i];  // t holds minus the sums
     }
   }
 }
 
 // Backward substitution L' y = y, as forward.
-void backward(SingleSupernodes::Data& f, int n, int columns) {
+template <int C>
+void backward(SingleSupernodes::Data& f, int n) {
   const int count = static_cast<int>(f.first.size()) - 1;
   const long stride = f.tallest;
+  const Columns<C> work(f.work.data(), stride, 0);
   for (int k = count - 1; k >= 0; --k) {
     const auto [first, width, height, below, L, rows] = block(f, k);
-    const auto own = [&](int c) { return f.y.data() + static_cast<long>(c) * n + first; };
-    const auto work = [&](int c) { return f.work.data() + c * stride; };
-    for (int c = 0; c < columns; ++c) {
+    const Columns<C> own(f.y.data(), n, first);
+    for (int c = 0; c < C; ++c) {
       const double* y = f.y.data() + static_cast<long>(c) * n;
-      double* t = work(c);
+      double* t = work.at[c];
       for (int i = 0; i < below; ++i) t[i] = y[rows[i]];
     }
-    double sums[4];
+    double sums[C][4];
     int j = 0;
     for (; j + 4 <= width; j += 4) {  // the rows below, four columns at a time
       const float* l[4];
       for (int q = 0; q < 4; ++q) l[q] = L + static_cast<long>(j + q) * height + width;
-      for (int c = 0; c < columns; ++c) {
-        dotColumns<4>(l, work(c), below, sums);
-        for (int q = 0; q < 4; ++q) own(c)[j + q] -= sums[q];
-      }
+      dotColumns<4, C>(l, work.at, below, sums);
+      for (int c = 0; c < C; ++c)
+        for (int q = 0; q < 4; ++q) own.at[c][j + q] -= sums[c][q];
     }
     for (; j < width; ++j) {
       const float* l = L + static_cast<long>(j) * height + width;
-      for (int c = 0; c < columns; ++c) {
-        dotColumns<1>(&l, work(c), below, sums);
-        own(c)[j] -= sums[0];
-      }
+      dotColumns<1, C>(&l, work.at, below, sums);
+      for (int c = 0; c < C; ++c) own.at[c][j] -= sums[c][0];
     }
     // The diagonal block's triangle, transposed, in forward's panels from the last: the last
     // columns (fewer than four) one by one, then each panel's dot products with the rows below
@@ -195,8 +226,7 @@ void backward(SingleSupernodes::Data& f, int n, int columns) {
     const int panels = width & ~3;
     for (int jj = width - 1; jj >= panels; --jj) {
       const float* column = L + static_cast<long>(jj) * height;
-      for (int c = 0; c < columns; ++c) {
-        double* y = own(c);
+      for (double* y : own.at) {
         double sum = y[jj];
         for (int r = jj + 1; r < width; ++r) sum -= double(column[r]) * y[r];
         y[jj] = sum * f.inverseDiagonal[first + jj];
@@ -205,18 +235,24 @@ void backward(SingleSupernodes::Data& f, int n, int columns) {
     for (int panel = panels - 4; panel >= 0; panel -= 4) {
       const float* l[4];
       for (int q = 0; q < 4; ++q) l[q] = L + static_cast<long>(panel + q) * height + panel + 4;
-      for (int c = 0; c < columns; ++c) {
-        double* y = own(c);
-        dotColumns<4>(l, y + panel + 4, width - panel - 4, sums);
+      dotColumns<4, C>(l, own.shifted(panel + 4).at, width - panel - 4, sums);
+      for (int c = 0; c < C; ++c) {
+        double* y = own.at[c];
         for (int q = 3; q >= 0; --q) {
           const float* column = L + static_cast<long>(panel + q) * height;
-          double sum = y[panel + q] - sums[q];
+          double sum = y[panel + q] - sums[c][q];
           for (int r = q + 1; r < 4; ++r) sum -= double(column[panel + r]) * y[panel + r];
           y[panel + q] = sum * f.inverseDiagonal[first + panel + q];
         }
       }
     }
   }
+}
+
+template <int C>
+void substitute(SingleSupernodes::Data& f, int n) {
+  forward<C>(f, n);
+  backward<C>(f, n);
 }
 
 }  // namespace
@@ -258,8 +294,15 @@ void SingleSupernodes::copy(const cholmod_factor& L, int n) {
 }
 
 void SingleSupernodes::solve(int columns) {
-  forward(data_, n_, columns);
-  backward(data_, n_, columns);
+  JELLO_ASSERT(columns >= 1 && columns <= 3, "one to three right-hand sides");
+  switch (columns) {
+    case 1:
+      return substitute<1>(data_, n_);
+    case 2:
+      return substitute<2>(data_, n_);
+    default:
+      return substitute<3>(data_, n_);
+  }
 }
 
 }  // namespace jello
