@@ -10,6 +10,10 @@
 
 #include "src/assertions.h"
 
+// Without AVX (JELLO_NATIVE off, a generic x86-64 build) GCC warns that passing these vectors
+// by value changes the ABI: they never leave this file.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 namespace jello {
 namespace {
 
@@ -20,49 +24,85 @@ namespace {
 // every product and sum is in double. The right-hand sides are solved side by side, each
 // contiguous, four rows to a vector.
 
-using Floats4 = float __attribute__((vector_size(16)));
-using Doubles4 = double __attribute__((vector_size(32)));
+// W doubles to a vector: 8 with AVX-512 (one instruction widens eight floats), and 4 for what
+// is left of a column or without it.
+template <int W>
+struct VectorOf;
+template <>
+struct VectorOf<4> {
+  using type = double __attribute__((vector_size(32)));
+};
+template <>
+struct VectorOf<8> {
+  using type = double __attribute__((vector_size(64)));
+};
+template <int W>
+using Doubles = typename VectorOf<W>::type;
 
-inline Doubles4 widen(const float* p) {
-#ifdef __AVX__
-  return Doubles4(_mm256_cvtps_pd(_mm_loadu_ps(p)));  // one instruction, where the generic
-#else                                                 // conversion below compiles to four
-  Floats4 f;
-  std::memcpy(&f, p, sizeof f);
-  return __builtin_convertvector(f, Doubles4);
+template <int W>
+inline Doubles<W> widen(const float* p) {
+#ifdef __AVX512F__
+  if constexpr (W == 8) return Doubles<8>(_mm512_cvtps_pd(_mm256_loadu_ps(p)));
 #endif
+#ifdef __AVX__
+  if constexpr (W == 4) return Doubles<4>(_mm256_cvtps_pd(_mm_loadu_ps(p)));  // one instruction,
+#endif  // where the generic conversion below compiles to four
+  float f[W];
+  std::memcpy(f, p, sizeof f);
+  Doubles<W> d;
+  for (int i = 0; i < W; ++i) d[i] = double(f[i]);
+  return d;
 }
-inline Doubles4 load(const double* p) {
-  Doubles4 d;
+template <int W>
+inline Doubles<W> load(const double* p) {
+  Doubles<W> d;
   std::memcpy(&d, p, sizeof d);
   return d;
 }
-inline void store(double* p, Doubles4 d) {
+template <int W>
+inline void store(double* p, Doubles<W> d) {
   std::memcpy(p, &d, sizeof d);
 }
-inline double total(Doubles4 v) {
-  return (v[0] + v[1]) + (v[2] + v[3]);
+template <int W>
+inline double total(Doubles<W> v) {
+  double sum = 0.0;
+  for (int i = 0; i < W; ++i) sum += v[i];
+  return sum;
 }
 
+#ifdef __AVX512F__
+constexpr int kWide = 8;
+#else
+constexpr int kWide = 4;
+#endif
+
 // The kernels below take the C <= 3 right-hand sides side by side: each float of L is widened
-// once for all of them (one at a time, the conversions were half the solve at 16^3).
+// once for all of them (one at a time, the conversions were half the solve at 16^3), W rows at
+// a time from row i on; they return the first row left.
 
 // y[c][i] -= sum over the q < B columns of l[q][i] a[c][q], i < count, for c < C.
-template <int B, int C>
-void subtractColumns(double* const* y, const float* const* l, const double* const* a, int count) {
-  int i = 0;
-  for (; i + 4 <= count; i += 4) {
-    Doubles4 sum[C];
+template <int W, int B, int C>
+int subtractRows(double* const* y, const float* const* l, const double* const* a, int i,
+                 int count) {
+  for (; i + W <= count; i += W) {
+    Doubles<W> sum[C];
     {
-      const Doubles4 li = widen(l[0] + i);
+      const Doubles<W> li = widen<W>(l[0] + i);
       for (int c = 0; c < C; ++c) sum[c] = li * a[c][0];
     }
     for (int q = 1; q < B; ++q) {
-      const Doubles4 li = widen(l[q] + i);
+      const Doubles<W> li = widen<W>(l[q] + i);
       for (int c = 0; c < C; ++c) sum[c] += li * a[c][q];
     }
-    for (int c = 0; c < C; ++c) store(y[c] + i, load(y[c] + i) - sum[c]);
+    for (int c = 0; c < C; ++c) store<W>(y[c] + i, load<W>(y[c] + i) - sum[c]);
   }
+  return i;
+}
+
+template <int B, int C>
+void subtractColumns(double* const* y, const float* const* l, const double* const* a, int count) {
+  int i = subtractRows<kWide, B, C>(y, l, a, 0, count);
+  if constexpr (kWide > 4) i = subtractRows<4, B, C>(y, l, a, i, count);
   for (; i < count; ++i) {
     for (int c = 0; c < C; ++c) {
       double sum = 0.0;
@@ -72,36 +112,49 @@ void subtractColumns(double* const* y, const float* const* l, const double* cons
   }
 }
 
-// out[c][q] = sum over i < count of l[q][i] x[c][i], for the q < B columns and c < C. Few
-// products run over several accumulators: one alone would wait on the adder's latency.
-template <int B, int C>
-void dotColumns(const float* const* l, const double* const* x, int count, double (*out)[4]) {
+// sum[c][q] += l[q][i] x[c][i] over the rows, kChains vectors of W rows at a time: few products
+// run over several accumulators (one alone would wait on the adder's latency).
+template <int W, int B, int C>
+int dotRows(const float* const* l, const double* const* x, int i, int count, double (*out)[4]) {
   constexpr int kChains = B * C >= 4 ? 1 : (B * C == 1 ? 4 : 2);
-  Doubles4 sum[C][B][kChains] = {};
-  int i = 0;
-  for (; i + 4 * kChains <= count; i += 4 * kChains) {
+  Doubles<W> sum[C][B][kChains] = {};
+  for (; i + W * kChains <= count; i += W * kChains) {
     for (int u = 0; u < kChains; ++u) {
-      Doubles4 xi[C];
-      for (int c = 0; c < C; ++c) xi[c] = load(x[c] + i + 4 * u);
+      Doubles<W> xi[C];
+      for (int c = 0; c < C; ++c) xi[c] = load<W>(x[c] + i + W * u);
       for (int q = 0; q < B; ++q) {
-        const Doubles4 li = widen(l[q] + i + 4 * u);
+        const Doubles<W> li = widen<W>(l[q] + i + W * u);
         for (int c = 0; c < C; ++c) sum[c][q][u] += li * xi[c];
       }
     }
   }
-  for (; i + 4 <= count; i += 4) {
+  for (; i + W <= count; i += W) {
     for (int q = 0; q < B; ++q) {
-      const Doubles4 li = widen(l[q] + i);
-      for (int c = 0; c < C; ++c) sum[c][q][0] += li * load(x[c] + i);
+      const Doubles<W> li = widen<W>(l[q] + i);
+      for (int c = 0; c < C; ++c) sum[c][q][0] += li * load<W>(x[c] + i);
     }
   }
   for (int c = 0; c < C; ++c)
     for (int q = 0; q < B; ++q) {
-      Doubles4 all = sum[c][q][0];
+      Doubles<W> all = sum[c][q][0];
       for (int u = 1; u < kChains; ++u) all += sum[c][q][u];
+      out[c][q] += total<W>(all);
+    }
+  return i;
+}
+
+// out[c][q] = sum over i < count of l[q][i] x[c][i], for the q < B columns and c < C.
+template <int B, int C>
+void dotColumns(const float* const* l, const double* const* x, int count, double (*out)[4]) {
+  for (int c = 0; c < C; ++c)
+    for (int q = 0; q < B; ++q) out[c][q] = 0.0;
+  int i = dotRows<kWide, B, C>(l, x, 0, count, out);
+  if constexpr (kWide > 4) i = dotRows<4, B, C>(l, x, i, count, out);
+  for (int c = 0; c < C; ++c)
+    for (int q = 0; q < B; ++q) {
       double rest = 0.0;
       for (int r = i; r < count; ++r) rest += double(l[q][r]) * x[c][r];
-      out[c][q] = total(all) + rest;
+      out[c][q] += rest;
     }
 }
 
