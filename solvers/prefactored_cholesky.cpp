@@ -50,9 +50,9 @@ void substitute(int n, const std::vector<int>& rowStart, const std::vector<int>&
 // Above this many entries in L the copy and its indices no longer stay in cache, and supernodal
 // solves (dense blocks) win: measured over three right-hand sides at 512, 1,000, 1,728 and 4,096
 // points (L of 48,000, 139,000, 340,000 and 1.1 million entries), the copy solved in 0.45, 0.65,
-// 0.8 and 1.6 times CHOLMOD's time (kDefaultCopyLimit); the single-precision supernodes in 0.65,
-// -, 0.6 and 0.5 (BM_KeptFactorSolve: 50, 305 and 953 us at 8^3, 12^3, 16^3 against the copy's
-// 34, 297 and 2,230).
+// 0.8 and 1.6 times CHOLMOD's time (kDefaultCopyLimit); the single-precision supernodes
+// (BM_KeptFactorSolve, 2026-12-03): 38, 94 and 194 us at 8^3, 10^3 and 12^3 against the copy's
+// 33, 110 and 283.
 struct PrefactoredCholesky::Impl {
   cholmod_common common{};
   cholmod_factor* symbolic = nullptr;  // analysis of the pattern, factored in place

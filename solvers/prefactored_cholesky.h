@@ -7,11 +7,11 @@
 //   accumulators per row, so every entry of L is read once per triangle for all three columns
 //   and no chain of dependent additions limits the loop. Measured at 8^3 (512 points, 42,000
 //   entries in L): a solve for three columns takes about half of CHOLMOD's own supernodal solve.
-// - above (12^3 points and more: the copy and its indices no longer stay in cache), CHOLMOD's
+// - above (10^3 points and more: the copy and its indices no longer stay in cache), CHOLMOD's
 //   dense supernodes copied in single precision and solved by our own blocked substitutions
 //   (solvers/single_supernodes.h),
 //   every product and sum in double: these solves are bound by memory traffic, which the floats
-//   halve (BM_KeptFactorSolve: about twice as fast as CHOLMOD's double solve at 16^3 to 32^3). The
+//   halve (BM_KeptFactorSolve: about a third of CHOLMOD's double solve's time at 16^3 to 32^3). The
 //   answer is that of a factor rounded to single precision (about 1e-7 relative times the
 //   condition number): what a preconditioner or projective's fixed-point iterations need, whose
 //   residuals are evaluated in double. singlePrecision = false solves these by CHOLMOD.
@@ -31,7 +31,7 @@ namespace jello {
 class PrefactoredCholesky {
  public:
   // Factors with more entries than copyLimit are solved by CHOLMOD (the default: measured).
-  static constexpr long kDefaultCopyLimit = 400000;
+  static constexpr long kDefaultCopyLimit = 100000;
   // singlePrecision: larger factors are solved over a single-precision copy of CHOLMOD's
   // supernodes (every operation in double) instead of by CHOLMOD itself.
   explicit PrefactoredCholesky(long copyLimit = kDefaultCopyLimit, bool singlePrecision = true);

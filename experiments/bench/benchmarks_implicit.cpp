@@ -268,11 +268,13 @@ void BM_KeptFactorSolve(benchmark::State& st, KeptFactorWay way) {
 }
 BENCHMARK_CAPTURE(BM_KeptFactorSolve, copy, KeptFactorWay::Copy)
     ->Arg(8)
+    ->Arg(10)
     ->Arg(12)
     ->Arg(16)
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_KeptFactorSolve, single, KeptFactorWay::Single)
     ->Arg(8)
+    ->Arg(10)
     ->Arg(12)
     ->Arg(16)
     ->Arg(24)
@@ -280,6 +282,7 @@ BENCHMARK_CAPTURE(BM_KeptFactorSolve, single, KeptFactorWay::Single)
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_KeptFactorSolve, cholmod, KeptFactorWay::Cholmod)
     ->Arg(8)
+    ->Arg(10)
     ->Arg(12)
     ->Arg(16)
     ->Arg(24)
