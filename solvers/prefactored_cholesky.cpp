@@ -7,6 +7,7 @@
 #include <string>
 
 #include "solvers/blas_headroom.h"
+#include "solvers/diagonal_correction.h"
 #include "solvers/single_supernodes.h"
 
 namespace jello {
@@ -62,6 +63,7 @@ struct PrefactoredCholesky::Impl {
   bool copied = false;      // solves run over the copy, not through CHOLMOD
   bool singleCopy = false;  // solves run over the single-precision supernodes
   SingleSupernodes supernodes;
+  DiagonalCorrection correction;  // the diagonal's changes on top of the single-precision factor
   std::vector<int> inversePerm;
   std::vector<Lanes> lanes;
   std::vector<double> single;
@@ -93,6 +95,7 @@ PrefactoredCholesky::~PrefactoredCholesky() = default;
 void PrefactoredCholesky::forgetPattern() {
   cholmod_free_factor(&impl_->updated, &impl_->common);
   cholmod_free_factor(&impl_->symbolic, &impl_->common);
+  impl_->correction.clear();
   n_ = 0;
 }
 
@@ -129,6 +132,7 @@ StepResult PrefactoredCholesky::factorize(const SparseMatrix& A) {
     }
   }
   cholmod_free_factor(&s.updated, &s.common);  // a fresh factor: earlier updates are moot
+  s.correction.clear();
   s.singleCopy = false;
   cholmod_factor* L = s.symbolic;
   if (const std::string why = blasHeadroomProblem(); !why.empty()) {
@@ -216,6 +220,14 @@ StepResult PrefactoredCholesky::addToDiagonal(const std::vector<std::pair<int, d
   if (!factored()) return StepResult::failure("prefactored Cholesky: no factor to update");
   if (changes.empty()) return StepResult::success();
   const int n = n_;
+  if (s.singleCopy) {
+    // Solved through the single-precision factor, unchanged (cholmod_updown would leave a
+    // double simplicial factor for CHOLMOD to solve, at four times the cost).
+    const StepResult added = s.correction.add(
+        changes, n, [this](double* b, int columns) { return solveFactored(b, columns); });
+    if (!added.ok) forgetPattern();
+    return added;
+  }
   if (!s.updated) {
     // A simplicial LDL' copy of the supernodal factor: the form cholmod_updown works on.
     s.updated = cholmod_copy_factor(s.symbolic, &s.common);
@@ -301,9 +313,20 @@ StepResult PrefactoredCholesky::addToDiagonal(const std::vector<std::pair<int, d
 }
 
 StepResult PrefactoredCholesky::solve(double* b, int columns) const {
+  const StepResult solved = solveFactored(b, columns);
+  if (!solved.ok || impl_->correction.size() == 0) return solved;
+  for (int c = 0; c < columns; ++c) impl_->correction.apply(b + static_cast<long>(c) * n_);
+  return solved;
+}
+
+int PrefactoredCholesky::correctedPoints() const {
+  return impl_->correction.size();
+}
+
+StepResult PrefactoredCholesky::solveFactored(double* b, int columns) const {
   Impl& s = *impl_;
   const int n = n_;
-  if (s.singleCopy && !s.updated) {
+  if (s.singleCopy) {
     double* y = s.supernodes.workspace();
     for (int c = 0; c < columns; ++c) {
       for (int k = 0; k < n; ++k) y[c * n + k] = b[c * n + perm_[k]];

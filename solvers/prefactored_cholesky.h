@@ -15,8 +15,9 @@
 //   answer is that of a factor rounded to single precision (about 1e-7 relative times the
 //   condition number): what a preconditioner or projective's fixed-point iterations need, whose
 //   residuals are evaluated in double. singlePrecision = false solves these by CHOLMOD.
-// After addToDiagonal (CHOLMOD's updates of a simplicial copy), large factors are solved by
-// CHOLMOD until the next factorize. Solves allocate nothing after the first.
+// After addToDiagonal, single-precision factors are solved with a low-rank correction, the others
+// over CHOLMOD's updates of a simplicial copy (large ones by CHOLMOD) until the next factorize.
+// Solves allocate nothing after the first.
 #pragma once
 
 #include <memory>
@@ -48,11 +49,16 @@ class PrefactoredCholesky {
   int size() const { return n_; }
   long nonZeros() const;  // entries of L, diagonal included
 
-  // A + diag(delta) in place of A, for the (point, delta) pairs given (a point at most once):
-  // CHOLMOD's rank-one updates (delta > 0) and downdates (delta < 0) of a simplicial copy of the
-  // factor (cholmod_updown), instead of a new factorization. The matrix must stay positive
-  // definite; a failure leaves no factor.
+  // A + diag(delta) in place of A, for the (point, delta) pairs given (a point at most once),
+  // instead of a new factorization: CHOLMOD's rank-one updates (delta > 0) and downdates
+  // (delta < 0) of a simplicial copy of the factor (cholmod_updown); for the single-precision
+  // supernodes a low-rank correction solved through the unchanged factor
+  // (solvers/diagonal_correction.h: one solve for each point that joins it). The matrix must
+  // stay positive definite; a failure leaves no factor.
   StepResult addToDiagonal(const std::vector<std::pair<int, double>>& changes);
+  // The points whose diagonal differs from the factored matrix's by a low-rank correction (0
+  // when updates went into the factor itself): each costs every solve a gather and an axpy.
+  int correctedPoints() const;
 
   // Solves A X = B in place: b holds `columns` (1 to 3) right-hand sides of size() entries one
   // after the other, and receives the solutions. Fails only when CHOLMOD's own solve does
@@ -64,6 +70,7 @@ class PrefactoredCholesky {
   std::unique_ptr<Impl> impl_;
   long copyLimit_;
   bool singlePrecision_;
+  StepResult solveFactored(double* b, int columns) const;  // the factor, without corrections
   StepResult solveByCholmod(double* b, int columns) const;
   void transposeCopy();  // L by rows from L by columns
   int n_ = 0;

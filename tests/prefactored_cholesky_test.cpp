@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <vector>
 
 #include "src/model.h"
@@ -116,6 +117,47 @@ TEST_P(PrefactoredCholeskyBothWays, UpdatesAndDowndatesTheDiagonal) {
   Eigen::MatrixXd X = B;
   ASSERT_TRUE(factor.solve(X.data(), 1).ok);
   EXPECT_LT((Eigen::MatrixXd(A) * X - B).norm(), 10 * tolerance() * B.norm() * dense.norm());
+}
+
+// The single-precision factor takes diagonal changes as a low-rank correction solved through
+// it (solvers/diagonal_correction.h): as close to a factorization of the changed matrix as the
+// factor itself is to the original, over rounds that add points, change them again and take
+// some back out (the correction then shrinks), and cleared by the next factorization.
+TEST(PrefactoredCholesky, SinglePrecisionFactorsSolveDiagonalChangesThroughACorrection) {
+  const Model model(resampleCube(test::loadWorld("jello.w"), 6));
+  const int n = model.numPoints();
+  const SparseMatrix A = laplacianSystem(model, 3.0, 0.1);
+  PrefactoredCholesky factor(0, true);  // single precision at any size
+  ASSERT_TRUE(factor.factorize(A).ok);
+  Eigen::MatrixXd dense(A);
+  const Eigen::MatrixXd B = Eigen::MatrixXd::Random(n, 3);
+  const auto relativeError = [&](int columns) {
+    Eigen::MatrixXd X = B.leftCols(columns);
+    EXPECT_TRUE(factor.solve(X.data(), columns).ok);
+    const Eigen::MatrixXd exact = dense.llt().solve(B.leftCols(columns));
+    return (X - exact).norm() / exact.norm();
+  };
+  const double unchanged = relativeError(3);
+  EXPECT_LT(unchanged, 1e-6);
+  const std::vector<std::vector<std::pair<int, double>>> rounds = {
+      {{3, 5e3}, {40, 5e3}, {41, 5e3}, {100, 2e4}, {215, 5e3}},  // contacts arrive
+      {{40, -5e3}, {7, 1e4}, {100, 3e3}, {41, -2.0}},            // one leaves, one more
+      {{3, -5e3}, {7, -1e4}, {215, -5e3}},                       // three leave
+  };
+  const int sizes[] = {5, 5, 2};  // points corrected after each round (41 and 100 at the end)
+  for (std::size_t r = 0; r < rounds.size(); ++r) {
+    SCOPED_TRACE(r);
+    ASSERT_TRUE(factor.addToDiagonal(rounds[r]).ok);
+    for (const auto& [p, delta] : rounds[r]) dense(p, p) += delta;
+    EXPECT_EQ(factor.correctedPoints(), sizes[r]);
+    for (int columns = 1; columns <= 3; ++columns) {
+      EXPECT_LT(relativeError(columns), std::max(1e-7, 3 * unchanged)) << columns;
+    }
+  }
+  dense = Eigen::MatrixXd(A);
+  ASSERT_TRUE(factor.factorize(A).ok);  // from scratch: the correction goes
+  EXPECT_EQ(factor.correctedPoints(), 0);
+  EXPECT_LT(relativeError(3), std::max(1e-7, 3 * unchanged));
 }
 
 INSTANTIATE_TEST_SUITE_P(CopySingleAndCholmod, PrefactoredCholeskyBothWays,
