@@ -18,6 +18,11 @@ using Clock = std::chrono::steady_clock;
 // factoring afresh. Measured on 1 s of jello.w at 8^3: of 96 contact changes 82 became updates,
 // and the time spent on factors fell from 80 to 46 ms (limits 8, 64 and 128 within noise).
 constexpr int kUpdateLimit = 64;
+// Large factors take such changes as a low-rank correction (PrefactoredCholesky::addToDiagonal),
+// which every solve then pays for: at most this many points in it, then a new factorization.
+// Measured on 1 s of jello.w at 16^3: 2.45 s with 128 (41 factorizations), 2.65 s with 256 (39),
+// 2.75 s without a limit; 4.6 s when updates made CHOLMOD solve a double simplicial factor.
+constexpr int kCorrectionLimit = 128;
 
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -86,24 +91,31 @@ StepResult ProjectiveIntegrator::factorChanged(double h) {
       factorOf_[c] = same;
       continue;
     }
-    if (!all && factorOf_[c] == c && weights_[c] == factoredWeights_[c]) continue;
+    // Its own factor (kept while it shared another's) still holds or nearly holds its matrix.
+    const bool own = !all && factors_->llt[c].factored();
+    if (own && weights_[c] == factoredWeights_[c]) {
+      factorOf_[c] = c;
+      continue;
+    }
     const auto start = Clock::now();
-    if (options_.updateFactors && !all && factorOf_[c] == c && factors_->llt[c].factored()) {
+    if (options_.updateFactors && own) {
       // Its own factor, for this h: a few points entered or left contact. Rank-one updates
-      // and downdates of the diagonal, when few enough to beat a new factorization. (At 16^3
-      // too, where an updated factor is solved by CHOLMOD in double rather than over its
-      // single-precision supernodes: 1 s of jello.w took 5.0 s updating, 6.7 s refactoring.)
+      // and downdates of the diagonal, or for large factors a low-rank correction, when few
+      // enough to beat a new factorization.
       changes_.clear();
       for (int p = 0; p < n_; ++p) {
         const double delta = weights_[c][p] - factoredWeights_[c][p];
         if (delta != 0.0) changes_.emplace_back(p, delta);
       }
-      if (static_cast<int>(changes_.size()) <= kUpdateLimit) {
+      const int changed = static_cast<int>(changes_.size());
+      if (changed <= kUpdateLimit &&
+          factors_->llt[c].correctedPoints() + changed <= kCorrectionLimit) {
         const StepResult updated = factors_->llt[c].addToDiagonal(changes_);
         factorSeconds_ += secondsSince(start);
         ++updates_;
         if (!updated.ok) return updated.within("projective matrix");
         factoredWeights_[c] = weights_[c];
+        factorOf_[c] = c;
         continue;
       }
     }
