@@ -47,7 +47,7 @@ class SpringForces {
   // state: threads may evaluate one SpringForces at once. From kParallelMinPoints points up
   // the work is split over parallelThreads() threads (src/parallel.h).
   void accumulate(const double* x, const double* v, double* f) const;
-  double energy(const double* x) const;  // J
+  double energy(const double* x) const;  // J; split over threads as accumulate is
   // Adds the springs' blocks of K and D at positions x (the forces are linear in v, so D does
   // not depend on it), u the unit vector along a spring, P = u u^T, alpha = 1 - L0/l:
   //   Ke = -k [ P + alpha (I - P) ],  De = -c P   on (a,a) and (b,b); -Ke, -De on (a,b), (b,a).
@@ -64,6 +64,8 @@ class SpringForces {
   // The springs whose base point is in [lo, hi) (both ends' forces).
   void accumulateRange(const double* x, const double* v, double* f, std::ptrdiff_t lo,
                        std::ptrdiff_t hi) const;
+  // The energy of part `part` of `parts` of each group's springs.
+  double energyRange(const double* x, int part, int parts) const;
 
   std::vector<SpringGroup> groups_;
   int n_;

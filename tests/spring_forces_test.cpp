@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <random>
+#include <string>
 
 #include "solvers/explicit_integrators.h"
 #include "src/model.h"
@@ -80,7 +81,8 @@ TEST(SpringForces, FreeCubeKeepsItsMomentumUnderRK4) {
 
 // Both cores (src/parallel.h): the threaded evaluation splits the base points into runs with
 // gaps between them; it equals the serial sum to round-off, for 2 and 3 threads, at 32^3 on a
-// deformed moving cube. Below kParallelMinPoints (16^3) it is the serial sum, bit for bit.
+// deformed moving cube, as do the springs' energy and a whole RK4 step. Below
+// kParallelMinPoints (16^3) each is the serial result, bit for bit.
 TEST(SpringForces, ThreadedEvaluationEqualsTheSerialOne) {
   for (int n : {16, 32}) {
     const World w = resampleCube(test::loadWorld("jello.w"), n);
@@ -95,16 +97,29 @@ TEST(SpringForces, ThreadedEvaluationEqualsTheSerialOne) {
     setParallelThreads(1);
     Eigen::VectorXd serial = Eigen::VectorXd::Zero(s.x.size());
     model.springs().accumulate(s.x.data(), s.v.data(), serial.data());
+    const double serialEnergy = model.springs().energy(s.x.data());
+    State serialStep = s;  // and a whole RK4 step (its fused vector passes split too)
+    ASSERT_TRUE(RungeKutta4().step(model, serialStep, 1e-4).ok);
     for (int threads : {2, 3}) {
+      SCOPED_TRACE(std::to_string(n) + "^3, " + std::to_string(threads) + " threads");
       setParallelThreads(threads);
       Eigen::VectorXd threaded = Eigen::VectorXd::Zero(s.x.size());
       model.springs().accumulate(s.x.data(), s.v.data(), threaded.data());
-      EXPECT_LE((threaded - serial).cwiseAbs().maxCoeff(), 1e-12 * serial.cwiseAbs().maxCoeff())
-          << n << "^3, " << threads << " threads";
+      EXPECT_LE((threaded - serial).cwiseAbs().maxCoeff(), 1e-12 * serial.cwiseAbs().maxCoeff());
+      const double energy = model.springs().energy(s.x.data());
+      EXPECT_NEAR(energy, serialEnergy, 1e-12 * serialEnergy);
+      State step = s;
+      ASSERT_TRUE(RungeKutta4().step(model, step, 1e-4).ok);
+      EXPECT_LE((step.x - serialStep.x).cwiseAbs().maxCoeff(), 1e-13);
+      EXPECT_LE((step.v - serialStep.v).cwiseAbs().maxCoeff(),
+                1e-12 * (serialStep.v - s.v).cwiseAbs().maxCoeff());
       if (n * n * n < kParallelMinPoints) {
         EXPECT_EQ(threaded, serial);
+        EXPECT_EQ(energy, serialEnergy);
+        EXPECT_EQ(step.x, serialStep.x);
       }
       EXPECT_GT(serial.cwiseAbs().maxCoeff(), 1.0);
+      EXPECT_GT(serialEnergy, 1.0);
     }
     setParallelThreads(1);
   }
