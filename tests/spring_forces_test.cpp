@@ -98,7 +98,7 @@ TEST(SpringForces, ThreadedEvaluationEqualsTheSerialOne) {
     Eigen::VectorXd serial = Eigen::VectorXd::Zero(s.x.size());
     model.springs().accumulate(s.x.data(), s.v.data(), serial.data());
     const double serialEnergy = model.springs().energy(s.x.data());
-    State serialStep = s;  // and a whole RK4 step (its fused vector passes split too)
+    State serialStep = s;  // and a whole RK4 step
     ASSERT_TRUE(RungeKutta4().step(model, serialStep, 1e-4).ok);
     for (int threads : {2, 3}) {
       SCOPED_TRACE(std::to_string(n) + "^3, " + std::to_string(threads) + " threads");
