@@ -29,10 +29,14 @@ int defaultThreads() {
 std::atomic<int> configuredThreads{0};  // 0: not decided yet
 
 // Workers wait for a new generation, run their part, and count themselves done. Between the
-// loops of one step (an RK4 step evaluates the forces four times, microseconds apart) waiting
-// threads spin for up to kSpin before they block: waking a blocked thread costs tens of
-// microseconds on a VM, as much as a 16^3 loop's whole gain.
-constexpr auto kSpin = std::chrono::microseconds(20);
+// loops of one step (an RK4 step evaluates the forces four times, its serial updates, contact
+// and energy check between them) waiting threads spin for up to kSpin before they block: waking
+// a blocked thread costs tens of microseconds on a VM, as much as a 16^3 loop's whole gain. The
+// serial work between two 32^3 loops is longer than 20 us: a whole 32^3 RK4 step on two threads
+// took 3.71-3.81 ms spinning 20 us, 3.53-3.57 ms at 100, 3.27-3.44 ms at 300, 3.21-3.33 ms at
+// 1,000 (BM_Threads, medians of 5, alternating; one thread 4.58 ms). Only loops from
+// kParallelMinPoints up use the pool, so smaller scenes never spin.
+constexpr auto kSpin = std::chrono::microseconds(300);
 
 template <class Done>
 void spinUntil(Done done) {
