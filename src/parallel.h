@@ -1,5 +1,5 @@
 // Both cores for the model's large loops (README "Speed"): a small pool of worker threads that
-// runs the parts of one loop at once. Only the spring forces use it, and only from
+// runs the parts of one loop at once. Only the spring forces and energy use it, and only from
 // kParallelMinPoints points up, where a loop is long enough (milliseconds) to pay for waking a
 // thread and for the worker's spinning beside the step's serial rest. The pool is shared by the
 // process: a caller that finds it busy (another thread's loop, an experiment's parallel grid)
