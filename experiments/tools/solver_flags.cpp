@@ -10,133 +10,100 @@ void addSolverFlags(CLI::App& app, SolverFlags& f) {
   auto& cvode = f.solver.cvode;
   const char* implicitGroup =
       "Implicit solvers (implicit, midpoint, newmark, bdf2, implicit-linear, cvode)";
-  app.add_option("--linear-solver", f.linearSolver,
-                 "cg (preconditioned, warm-started, matrix-free; the default), cholmod "
-                 "(supernodal LLT) or ldlt")
-      ->check(CLI::IsMember({"cholmod", "ldlt", "cg"}))
-      ->group(implicitGroup);
-  app.add_option("--preconditioner", f.preconditioner,
-                 "cg: jacobi, block-jacobi (each point's 3x3 block), ichol (incomplete "
-                 "Cholesky), factor (a CHOLMOD factor of an earlier matrix, refreshed when CG "
-                 "needs more than 10 iterations) or projective (the springs' Laplacian "
-                 "M + L(a c + b k) with the contacts on its diagonal, factored once per step "
-                 "size and contact set)")
-      ->check(CLI::IsMember({"jacobi", "block-jacobi", "ichol", "factor", "projective"}))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_flag("--csr-product", f.csrProduct,
-               "cg: multiply by the sparse matrix instead of through the spring kernels")
-      ->group(implicitGroup);
-  app.add_flag("--no-clamp", f.noClamp,
-               "Do not clamp compressed springs' Jacobians (the system may be indefinite)")
-      ->group(implicitGroup);
-  app.add_option("--cg-tol", implicit.cgTolerance, "Relative residual of CG solves")
-      ->check(cli::positive())
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--newton-iters", implicit.newtonMaxIterations,
-                 "implicit, midpoint, newmark, bdf2: most Newton iterations per step (a step "
-                 "still unconverged is counted and reported)")
-      ->check(cli::range(1, 1000))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--newton-tol", implicit.newtonTolerance,
-                 "implicit, midpoint, newmark, bdf2: relative residual that ends the iterations")
-      ->check(cli::positive())
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--newton-xtol", implicit.newtonPositionTolerance,
-                 "implicit, midpoint, newmark, bdf2: a Newton update moving no coordinate more "
-                 "than this (m) also ends them")
-      ->check(cli::positive())
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_flag("--no-factor-reuse", f.noFactorReuse,
-               "implicit, midpoint, newmark, bdf2: factor the Newton matrix at every iteration "
-               "(plain Newton) instead of keeping it while it converges fast enough")
-      ->group(implicitGroup);
-  app.add_option("--refactor-ratio", implicit.refactorRatio,
-                 "implicit, midpoint, newmark, bdf2: factor afresh when an iteration shrinks "
-                 "the residual by less than this")
-      ->check(cli::range(1e-6, 1.0))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--newton-seed", implicit.seedIterations,
-                 "implicit, midpoint, newmark, bdf2: iterations with the constant projective "
-                 "matrix before Newton (stopped at the first iterate in contact; 0: none)")
-      ->check(cli::range(0, 1000))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--newton-seed-tol", implicit.seedTolerance,
-                 "implicit, midpoint, newmark, bdf2: relative residual that ends the seed "
-                 "iterations (at or below --newton-tol they may converge the step themselves)")
-      ->check(cli::positive())
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--newton-seed-chebyshev", implicit.seedChebyshevRho,
-                 "implicit, midpoint, newmark, bdf2: Chebyshev acceleration of the seed "
-                 "iterations with this rho, as --projective-chebyshev (0: off; 0.9 measured "
-                 "best with --newton-seed-tol 1e-8)")
-      ->check(cli::range(0.0, 0.999))
-      ->capture_default_str()
-      ->group(implicitGroup);
+  // Every flag here is in the group; `option` also shows its default in --help, `bare` does
+  // not (a 0 there means "derived" or "none", said in the text).
+  const auto bare = [&](const char* name, auto& value, const std::string& help) {
+    return app.add_option(name, value, help)->group(implicitGroup);
+  };
+  const auto option = [&](const char* name, auto& value, const std::string& help) {
+    return bare(name, value, help)->capture_default_str();
+  };
+  const auto flag = [&](const char* name, bool& value, const std::string& help) {
+    return app.add_flag(name, value, help)->group(implicitGroup);
+  };
+  bare("--linear-solver", f.linearSolver,
+       "cg (preconditioned, warm-started, matrix-free; the default), cholmod "
+       "(supernodal LLT) or ldlt")
+      ->check(CLI::IsMember({"cholmod", "ldlt", "cg"}));
+  option("--preconditioner", f.preconditioner,
+         "cg: jacobi, block-jacobi (each point's 3x3 block), ichol (incomplete "
+         "Cholesky), factor (a CHOLMOD factor of an earlier matrix, refreshed when CG "
+         "needs more than 10 iterations) or projective (the springs' Laplacian "
+         "M + L(a c + b k) with the contacts on its diagonal, factored once per step "
+         "size and contact set)")
+      ->check(CLI::IsMember({"jacobi", "block-jacobi", "ichol", "factor", "projective"}));
+  flag("--csr-product", f.csrProduct,
+       "cg: multiply by the sparse matrix instead of through the spring kernels");
+  flag("--no-clamp", f.noClamp,
+       "Do not clamp compressed springs' Jacobians (the system may be indefinite)");
+  option("--cg-tol", implicit.cgTolerance, "Relative residual of CG solves")
+      ->check(cli::positive());
+  option("--newton-iters", implicit.newtonMaxIterations,
+         "implicit, midpoint, newmark, bdf2: most Newton iterations per step (a step "
+         "still unconverged is counted and reported)")
+      ->check(cli::range(1, 1000));
+  option("--newton-tol", implicit.newtonTolerance,
+         "implicit, midpoint, newmark, bdf2: relative residual that ends the iterations")
+      ->check(cli::positive());
+  option("--newton-xtol", implicit.newtonPositionTolerance,
+         "implicit, midpoint, newmark, bdf2: a Newton update moving no coordinate more "
+         "than this (m) also ends them")
+      ->check(cli::positive());
+  flag("--no-factor-reuse", f.noFactorReuse,
+       "implicit, midpoint, newmark, bdf2: factor the Newton matrix at every iteration "
+       "(plain Newton) instead of keeping it while it converges fast enough");
+  option("--refactor-ratio", implicit.refactorRatio,
+         "implicit, midpoint, newmark, bdf2: factor afresh when an iteration shrinks "
+         "the residual by less than this")
+      ->check(cli::range(1e-6, 1.0));
+  option("--newton-seed", implicit.seedIterations,
+         "implicit, midpoint, newmark, bdf2: iterations with the constant projective "
+         "matrix before Newton (stopped at the first iterate in contact; 0: none)")
+      ->check(cli::range(0, 1000));
+  option("--newton-seed-tol", implicit.seedTolerance,
+         "implicit, midpoint, newmark, bdf2: relative residual that ends the seed "
+         "iterations (at or below --newton-tol they may converge the step themselves)")
+      ->check(cli::positive());
+  option("--newton-seed-chebyshev", implicit.seedChebyshevRho,
+         "implicit, midpoint, newmark, bdf2: Chebyshev acceleration of the seed "
+         "iterations with this rho, as --projective-chebyshev (0: off; 0.9 measured "
+         "best with --newton-seed-tol 1e-8)")
+      ->check(cli::range(0.0, 0.999));
   auto& projective = f.solver.projective;
-  app.add_option("--projective-iters", projective.iterations,
-                 "projective: local/global iterations per step")
-      ->check(cli::range(1, 100000))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--projective-tol", projective.tolerance,
-                 "projective: stop a step's iterations early once an update moves no coordinate "
-                 "more than this (m; 0: never early)")
-      ->check(cli::nonNegative())
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--projective-chebyshev", projective.chebyshevRho,
-                 "projective: Chebyshev acceleration of the iterations (Wang 2015) with this "
-                 "assumed contraction rho, after 2 plain iterations (0: off; 0.85 measured best "
-                 "on the spinning stiff cube)")
-      ->check(cli::range(0.0, 0.999))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--rtol", cvode.rtol, "cvode: relative tolerance")
-      ->check(cli::positive())
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--cvode-method", f.cvodeMethod,
-                 "cvode: bdf (stiff: Newton over the implicit system) or adams (non-stiff: "
-                 "fixed-point iterations, no linear algebra)")
-      ->check(CLI::IsMember({"bdf", "adams"}))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_option("--atol", f.atol,
-                 "cvode: absolute tolerance of positions (m) and velocities (m/s) (default "
-                 "1e-3 * rtol)")
-      ->check(cli::positive())
-      ->group(implicitGroup);
-  app.add_option("--atol-x", cvode.atolPosition, "cvode: absolute tolerance of positions (m)")
-      ->check(cli::positive())
-      ->group(implicitGroup);
-  app.add_option("--atol-v", cvode.atolVelocity, "cvode: absolute tolerance of velocities (m/s)")
-      ->check(cli::positive())
-      ->group(implicitGroup);
-  app.add_flag("--cvode-krylov", cvode.krylov,
-               "cvode (bdf): solve Newton's systems by SPGMR, matrix-free, preconditioned by "
-               "the reduced system (--linear-solver), its factor kept between setups")
-      ->group(implicitGroup);
-  app.add_flag("--contact-roots", cvode.contactRoots,
-               "cvode: locate contact onset and release as roots and restart there")
-      ->group(implicitGroup);
-  app.add_option("--max-order", cvode.maxOrder, "cvode: largest BDF order")
-      ->check(cli::range(1, 5))
-      ->capture_default_str()
-      ->group(implicitGroup);
-  app.add_flag("--no-stab-lim-det", f.noStabLimDet,
-               "cvode: switch off BDF stability-limit detection")
-      ->group(implicitGroup);
-  app.add_option("--max-step", cvode.maxStep, "cvode: largest internal step, s (default none)")
-      ->check(cli::positive())
-      ->group(implicitGroup);
+  option("--projective-iters", projective.iterations,
+         "projective: local/global iterations per step")
+      ->check(cli::range(1, 100000));
+  option("--projective-tol", projective.tolerance,
+         "projective: stop a step's iterations early once an update moves no coordinate "
+         "more than this (m; 0: never early)")
+      ->check(cli::nonNegative());
+  option("--projective-chebyshev", projective.chebyshevRho,
+         "projective: Chebyshev acceleration of the iterations (Wang 2015) with this "
+         "assumed contraction rho, after 2 plain iterations (0: off; 0.85 measured best "
+         "on the spinning stiff cube)")
+      ->check(cli::range(0.0, 0.999));
+  option("--rtol", cvode.rtol, "cvode: relative tolerance")->check(cli::positive());
+  option("--cvode-method", f.cvodeMethod,
+         "cvode: bdf (stiff: Newton over the implicit system) or adams (non-stiff: "
+         "fixed-point iterations, no linear algebra)")
+      ->check(CLI::IsMember({"bdf", "adams"}));
+  bare("--atol", f.atol,
+       "cvode: absolute tolerance of positions (m) and velocities (m/s) (default "
+       "1e-3 * rtol)")
+      ->check(cli::positive());
+  bare("--atol-x", cvode.atolPosition, "cvode: absolute tolerance of positions (m)")
+      ->check(cli::positive());
+  bare("--atol-v", cvode.atolVelocity, "cvode: absolute tolerance of velocities (m/s)")
+      ->check(cli::positive());
+  flag("--cvode-krylov", cvode.krylov,
+       "cvode (bdf): solve Newton's systems by SPGMR, matrix-free, preconditioned by "
+       "the reduced system (--linear-solver), its factor kept between setups");
+  flag("--contact-roots", cvode.contactRoots,
+       "cvode: locate contact onset and release as roots and restart there");
+  option("--max-order", cvode.maxOrder, "cvode: largest BDF order")->check(cli::range(1, 5));
+  flag("--no-stab-lim-det", f.noStabLimDet, "cvode: switch off BDF stability-limit detection");
+  bare("--max-step", cvode.maxStep, "cvode: largest internal step, s (default none)")
+      ->check(cli::positive());
 }
 
 SolverOptions solverOptions(const SolverFlags& f) {
