@@ -18,7 +18,7 @@ namespace {
 int defaultThreads() {
   if (const char* env = std::getenv("JELLO_THREADS")) {
     const int t = std::atoi(env);
-    if (t >= 1) return std::min(t, 64);
+    if (t >= 1) return std::min(t, kMaxParallelThreads);
   }
   cpu_set_t set;
   int cpus = 1;
@@ -141,7 +141,7 @@ int parallelThreads() {
 }
 
 void setParallelThreads(int threads) {
-  configuredThreads.store(std::clamp(threads, 1, 64), std::memory_order_relaxed);
+  configuredThreads.store(std::clamp(threads, 1, kMaxParallelThreads), std::memory_order_relaxed);
 }
 
 void runParallel(int parts, const std::function<void(int)>& body) {

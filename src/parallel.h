@@ -15,6 +15,9 @@ namespace jello {
 // step share the VM's two CPUs); at 32^3 1.86x and 1.42x.
 inline constexpr int kParallelMinPoints = 32 * 32 * 32;
 
+// The most threads a loop is ever split over (JELLO_THREADS and setParallelThreads are clamped).
+inline constexpr int kMaxParallelThreads = 64;
+
 // The threads a loop is split over: setParallelThreads's value if called, else the environment's
 // JELLO_THREADS (1 = serial), else the CPUs this process may run on, at most 8.
 int parallelThreads();

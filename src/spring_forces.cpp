@@ -1,9 +1,9 @@
 #include "src/spring_forces.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
-#include <vector>
 
 #include "src/assertions.h"
 #include "src/parallel.h"
@@ -210,12 +210,13 @@ double SpringForces::energy(const double* x) const {
   if (threads <= 1) return energyRange(x, 0, 1);
   // Both cores from 32^3 (the divergence check's energy is as long as a force evaluation): each
   // part sums every group over its share of the base points; the parts' sums are then added in
-  // order (round-off apart from the serial sum).
-  std::vector<double> parts(static_cast<std::size_t>(threads));
+  // order (round-off apart from the serial sum). No allocation: the divergence check calls it
+  // step after step.
+  std::array<double, kMaxParallelThreads> parts{};
   runParallel(threads,
               [&](int t) { parts[static_cast<std::size_t>(t)] = energyRange(x, t, threads); });
   double e = 0.0;
-  for (const double part : parts) e += part;
+  for (int t = 0; t < threads; ++t) e += parts[static_cast<std::size_t>(t)];
   return e;
 }
 
