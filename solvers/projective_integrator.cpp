@@ -152,7 +152,6 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
     for (int c = 0; c < 3; ++c) changed = changed || weights_[c] != factoredWeights_[factorOf_[c]];
     changed = changed && factored_ && h == h_;
     if (changed) ++contactChanges_;
-    const bool contactChanged = changed;  // Chebyshev starts again from plain
     if (!factored_ || h != h_ || changed) {
       if (StepResult res = factorChanged(h); !res.ok) return res;
     }
@@ -168,23 +167,19 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
     }
     if (!solved.ok) return solved;
     solveSeconds_ += secondsSince(start);
-    double update;
-    if (options_.chebyshevRho <= 0.0) {
-      Eigen::Map<Eigen::MatrixXd>(x_.data(), n, 3) += delta_;
-      update = delta_.cwiseAbs().maxCoeff();
-    } else {
+    auto x = Eigen::Map<Eigen::MatrixXd>(x_.data(), n, 3);
+    if (options_.chebyshevRho > 0.0) {
       // A new contact set is a new iteration matrix: the Chebyshev run starts again.
-      const double omega = chebyshev_.next(delta_.norm(), contactChanged);
-      auto x = Eigen::Map<Eigen::MatrixXd>(x_.data(), n, 3);
+      const double omega = chebyshev_.next(delta_.norm(), changed);
       if (omega != 1.0) {
         // x_next = omega (x + delta - previous) + previous; delta becomes x_next - x.
         const auto prev = Eigen::Map<const Eigen::MatrixXd>(previous_.data(), n, 3);
         delta_ = omega * (x + delta_ - prev) + prev - x;
       }
       previous_ = x_;
-      x += delta_;
-      update = delta_.cwiseAbs().maxCoeff();
     }
+    x += delta_;
+    const double update = delta_.cwiseAbs().maxCoeff();
     lastUpdate_ = update;
     if (!std::isfinite(update)) return StepResult::failure("projective update is not finite");
     if (update <= options_.tolerance) {
