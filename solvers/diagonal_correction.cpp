@@ -1,8 +1,8 @@
 #include "solvers/diagonal_correction.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <string>
-#include <unordered_map>
 
 namespace jello {
 
@@ -18,17 +18,15 @@ StepResult DiagonalCorrection::add(const std::vector<std::pair<int, double>>& ch
     clear();
     Z_.resize(n, 0);
   }
-  std::unordered_map<int, int> index;
-  for (int j = 0; j < size(); ++j) index.emplace(points_[j], j);
   const int old = size();  // the points before, with their columns of Z; the joined after
-  for (const auto& [point, delta] : changes) {
+  for (const auto& [point, delta] : changes) {  // a few dozen points: a linear search
     if (delta == 0.0) continue;
-    const auto [at, inserted] = index.emplace(point, size());
-    if (inserted) {
+    const auto at = std::find(points_.begin(), points_.end(), point);
+    if (at == points_.end()) {
       points_.push_back(point);
       deltas_.push_back(delta);
     } else {
-      deltas_[at->second] += delta;
+      deltas_[static_cast<std::size_t>(at - points_.begin())] += delta;
     }
   }
   // Points whose changes cancelled (a contact that came and went) leave, with their columns.
