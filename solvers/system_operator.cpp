@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "src/assertions.h"
+#include "src/parallel.h"
 
 namespace jello {
 
@@ -13,16 +14,17 @@ constexpr int kUpper[6] = {0, 1, 2, 4, 5, 8};
 
 // y[s] += C[s] p[s] over a run of symmetric blocks (a group's springs, seen from one end, or the
 // points' diagonal blocks): unit stride, no dependence between iterations.
+// The blocks are c's entries from `first` on.
 void addBlockProducts(std::ptrdiff_t count, const std::array<std::vector<double>, 6>& c,
-                      const double* __restrict px, const double* __restrict py,
-                      const double* __restrict pz, double* __restrict yx, double* __restrict yy,
-                      double* __restrict yz) {
-  const double* __restrict cxx = c[0].data();
-  const double* __restrict cxy = c[1].data();
-  const double* __restrict cxz = c[2].data();
-  const double* __restrict cyy = c[3].data();
-  const double* __restrict cyz = c[4].data();
-  const double* __restrict czz = c[5].data();
+                      std::ptrdiff_t first, const double* __restrict px,
+                      const double* __restrict py, const double* __restrict pz,
+                      double* __restrict yx, double* __restrict yy, double* __restrict yz) {
+  const double* __restrict cxx = c[0].data() + first;
+  const double* __restrict cxy = c[1].data() + first;
+  const double* __restrict cxz = c[2].data() + first;
+  const double* __restrict cyy = c[3].data() + first;
+  const double* __restrict cyz = c[4].data() + first;
+  const double* __restrict czz = c[5].data() + first;
 #pragma omp simd
   for (std::ptrdiff_t s = 0; s < count; ++s) {
     yx[s] += cxx[s] * px[s] + cxy[s] * py[s] + cxz[s] * pz[s];
@@ -41,6 +43,7 @@ SystemOperator::SystemOperator(const SpringForces& springs, int numPoints) : n_(
     group.delta = g.delta;
     group.mask = g.mask;
     for (auto& c : group.c) c.assign(g.mask.size(), 0.0);
+    maxDelta_ = std::max(maxDelta_, group.delta);
     groups_.push_back(std::move(group));
   }
   for (auto& d : diag_) d.assign(static_cast<std::size_t>(n_), 0.0);
@@ -66,17 +69,34 @@ void SystemOperator::gather(const SparseMatrix& A, const std::vector<int>& diagS
 }
 
 void SystemOperator::apply(const double* p, double* y) const {
+  // Split over threads as the spring forces are (src/parallel.h): every group's springs write
+  // to their base points and partners at most maxDelta_ points further.
+  const int threads = n_ >= kParallelMinPoints ? parallelThreads() : 1;
+  runOverBasePoints(n_, maxDelta_, threads,
+                    [&](std::ptrdiff_t lo, std::ptrdiff_t hi, std::ptrdiff_t owned) {
+                      applyRange(p, y, lo, hi, owned);
+                    });
+}
+
+void SystemOperator::applyRange(const double* p, double* y, std::ptrdiff_t lo, std::ptrdiff_t hi,
+                                std::ptrdiff_t owned) const {
   const std::ptrdiff_t n = n_;
   const double *px = p, *py = p + n, *pz = p + 2 * n;
   double *yx = y, *yy = y + n, *yz = y + 2 * n;
-  // The points' own blocks first (y = G p), then every spring's, both ends.
-  std::fill(y, y + 3 * n, 0.0);
-  addBlockProducts(n, diag_, px, py, pz, yx, yy, yz);
+  // The points' own blocks first (y = G p) over the points this call owns, then every spring's
+  // with a base point in [lo, hi), both ends.
+  for (int c = 0; c < 3; ++c) std::fill(y + c * n + lo, y + c * n + owned, 0.0);
+  if (owned > lo) {
+    addBlockProducts(owned - lo, diag_, lo, px + lo, py + lo, pz + lo, yx + lo, yy + lo, yz + lo);
+  }
   for (const Group& g : groups_) {
-    const std::ptrdiff_t a = g.first, b = g.first + g.delta;
+    const std::ptrdiff_t begin = std::clamp<std::ptrdiff_t>(lo - g.first, 0, g.count);
+    const std::ptrdiff_t count = std::clamp<std::ptrdiff_t>(hi - g.first, 0, g.count) - begin;
+    if (count <= 0) continue;
+    const std::ptrdiff_t a = g.first + begin, b = a + g.delta;
     // Base points take their partners' values, then partners take the base points'.
-    addBlockProducts(g.count, g.c, px + b, py + b, pz + b, yx + a, yy + a, yz + a);
-    addBlockProducts(g.count, g.c, px + a, py + a, pz + a, yx + b, yy + b, yz + b);
+    addBlockProducts(count, g.c, begin, px + b, py + b, pz + b, yx + a, yy + a, yz + a);
+    addBlockProducts(count, g.c, begin, px + a, py + a, pz + a, yx + b, yy + b, yz + b);
   }
 }
 

@@ -149,4 +149,24 @@ void runParallel(int parts, const std::function<void(int)>& body) {
   for (int part = 0; part < parts; ++part) body(part);
 }
 
+void runOverBasePoints(
+    std::ptrdiff_t n, std::ptrdiff_t reach, int threads,
+    const std::function<void(std::ptrdiff_t, std::ptrdiff_t, std::ptrdiff_t)>& body) {
+  const std::ptrdiff_t run = threads > 1 ? (n - reach * (threads - 1)) / threads : n;
+  if (threads <= 1 || run <= reach) {
+    body(0, n, n);
+    return;
+  }
+  const auto runStart = [&](int t) { return t * (run + reach); };
+  runParallel(threads, [&](int t) {
+    const bool last = t + 1 == threads;
+    const std::ptrdiff_t lo = runStart(t);
+    body(lo, last ? n : lo + run, last ? n : runStart(t + 1));
+  });
+  for (int t = 0; t + 1 < threads; ++t) {
+    const std::ptrdiff_t lo = runStart(t) + run;
+    body(lo, runStart(t + 1), lo);
+  }
+}
+
 }  // namespace jello

@@ -6,6 +6,7 @@
 // runs its parts itself, one after another.
 #pragma once
 
+#include <cstddef>
 #include <functional>
 
 namespace jello {
@@ -27,5 +28,17 @@ void setParallelThreads(int threads);
 // Runs body(part) for part in [0, parts): part 0 on the calling thread, the others on the pool's
 // workers; returns when all are done. body must not throw.
 void runParallel(int parts, const std::function<void(int)>& body);
+
+// A loop over the base points [0, n) of springs (or of their matrix blocks) that writes to each
+// base point and to partners at most `reach` points after it, split over `threads`: [0, n) is cut
+// into `threads` runs separated by gaps of `reach` points, so no two runs write the same point,
+// and body(lo, hi, owned) runs for the runs at once, then for the gaps one after another. `owned`
+// ends the points the call writes first, to be set rather than added to: a run's own points and
+// the gap after it, [lo, owned); none for a gap (owned == lo), whose points and reach are the
+// runs' (written first by the run before it or after it, both done). One serial call (0, n, n)
+// for one thread, or when runs would be no longer than the gaps. body must not throw.
+void runOverBasePoints(
+    std::ptrdiff_t n, std::ptrdiff_t reach, int threads,
+    const std::function<void(std::ptrdiff_t, std::ptrdiff_t, std::ptrdiff_t)>& body);
 
 }  // namespace jello

@@ -8,6 +8,7 @@
 
 #include "solvers/implicit_system.h"
 #include "solvers/system_operator.h"
+#include "src/parallel.h"
 #include "src/scene_builder.h"
 #include "tests/test_support.h"
 
@@ -274,6 +275,45 @@ TEST(SystemOperator, ProductEqualsTheSparseMatrix) {
   const Eigen::VectorXd expected = A * p;
   EXPECT_LT((y - expected).cwiseAbs().maxCoeff(), 1e-13 * expected.cwiseAbs().maxCoeff());
   ASSERT_LT(s.x.tail(s.numPoints()).minCoeff(), -2.0);  // some points below the floor
+}
+
+// From 16^3 the product is split over threads (runs of base points, then the gaps between them):
+// on 1, 2 and 3 threads it equals the sparse matrix's, and the threaded products the serial one,
+// to round-off; below it stays serial, bit for bit.
+TEST(SystemOperator, ThreadedProductEqualsTheSerialOne) {
+  for (int n : {8, 16}) {
+    const World w = resampleCube(test::loadWorld("jello.w"), n);
+    State s = deformedJello(w);
+    s.x.tail(s.numPoints()).array() -= 2.3;  // the lower layers sink into the floor
+    const Model model(w);
+    JacobianAssembler jac(model);
+    jac.assemble(s.x.data(), {});
+    SparseMatrix A = jac.pattern();
+    jac.combine(0.01, 1e-4, A);
+    SystemOperator op(model.springs(), model.numPoints());
+    op.gather(A, jac.diagonalSlots(), jac.springSlots());
+    const Eigen::VectorXd p = Eigen::VectorXd::Random(s.x.size());
+    const Eigen::VectorXd expected = A * p;
+    const double scale = expected.cwiseAbs().maxCoeff();
+    setParallelThreads(1);
+    Eigen::VectorXd serial(p.size());
+    op.apply(p.data(), serial.data());
+    EXPECT_LT((serial - expected).cwiseAbs().maxCoeff(), 1e-13 * scale);
+    for (int threads : {2, 3}) {
+      SCOPED_TRACE(std::to_string(n) + "^3, " + std::to_string(threads) + " threads");
+      setParallelThreads(threads);
+      Eigen::VectorXd threaded = Eigen::VectorXd::Constant(p.size(), 1e300);  // all overwritten
+      op.apply(p.data(), threaded.data());
+      EXPECT_LT((threaded - expected).cwiseAbs().maxCoeff(), 1e-13 * scale);
+      EXPECT_LT((threaded - serial).cwiseAbs().maxCoeff(), 1e-13 * scale);
+      if (n * n * n < SystemOperator::kParallelMinPoints) {
+        EXPECT_EQ(threaded, serial);
+      } else {
+        EXPECT_NE(threaded, serial);  // split: some sums in another order
+      }
+    }
+    setParallelThreads(1);
+  }
 }
 
 }  // namespace

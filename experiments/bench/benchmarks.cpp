@@ -3,7 +3,8 @@
 // machine.
 //   BM_SpringForces/N    one evaluation of every spring; items/s = spring evaluations/s
 //   BM_Step/<integrator>/N  one full step on jello.w resampled to N^3; items/s = steps/s
-//   BM_Threads/...       the spring forces and an RK4 step on 1 and 2 threads (no taskset)
+//   BM_Threads/...       the spring forces, an RK4 step and the matrix-free product on 1 and 2
+//                        threads (no taskset)
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
@@ -11,8 +12,10 @@
 #include <memory>
 #include <string>
 
+#include "solvers/jacobian.h"
 #include "solvers/simulation.h"
 #include "solvers/solver_threads.h"
+#include "solvers/system_operator.h"
 #include "src/parallel.h"
 #include "src/scene_builder.h"
 #include "src/world_reader.h"
@@ -61,9 +64,12 @@ BENCHMARK_CAPTURE(BM_Step, rk4, jello::IntegratorKind::RK4)->Arg(8)->Arg(16)->Ar
 BENCHMARK_CAPTURE(BM_Step, euler, jello::IntegratorKind::Euler)->Arg(8);
 BENCHMARK_CAPTURE(BM_Step, symplectic, jello::IntegratorKind::Symplectic)->Arg(8);
 
-// Both cores (src/parallel.h): the spring forces and a whole RK4 step at N^3 with the given
-// number of threads, 1 (serial) against 2, in one run. Run without taskset.
-void BM_Threads(benchmark::State& state, bool wholeStep) {
+// Both cores (src/parallel.h): the spring forces, a whole RK4 step and the implicit solvers'
+// matrix-free product (backward Euler's matrix at dt = 0.01) at N^3 with the given number of
+// threads, 1 (serial) against 2, in one run. Run without taskset.
+enum class ThreadedWork { Springs, Rk4Step, Product };
+
+void BM_Threads(benchmark::State& state, ThreadedWork what) {
   const int n = static_cast<int>(state.range(0));
   const int threads = static_cast<int>(state.range(1));
   jello::setParallelThreads(threads);
@@ -71,24 +77,41 @@ void BM_Threads(benchmark::State& state, bool wholeStep) {
   jello::Simulation sim(world, jello::IntegratorKind::RK4);
   const jello::State s = jello::initialState(world);
   Eigen::VectorXd f = Eigen::VectorXd::Zero(s.x.size());
+  jello::JacobianAssembler jacobian(sim.model());
+  jacobian.assemble(s.x.data(), {});
+  jello::SparseMatrix A = jacobian.pattern();
+  jacobian.combine(0.01, 1e-4, A);
+  jello::SystemOperator product(sim.model().springs(), sim.model().numPoints());
+  product.gather(A, jacobian.diagonalSlots(), jacobian.springSlots());
   for (auto _ : state) {
-    if (wholeStep) {
-      if (!sim.step().ok) state.SkipWithError("diverged");
-    } else {
-      sim.model().springs().accumulate(s.x.data(), s.v.data(), f.data());
-      benchmark::DoNotOptimize(f.data());
-      benchmark::ClobberMemory();
+    switch (what) {
+      case ThreadedWork::Springs:
+        sim.model().springs().accumulate(s.x.data(), s.v.data(), f.data());
+        break;
+      case ThreadedWork::Rk4Step:
+        if (!sim.step().ok) state.SkipWithError("diverged");
+        break;
+      case ThreadedWork::Product:
+        product.apply(s.v.data(), f.data());
+        break;
     }
+    benchmark::DoNotOptimize(f.data());
+    benchmark::ClobberMemory();
   }
   state.counters["threads"] = threads;
   jello::setParallelThreads(1);
 }
-BENCHMARK_CAPTURE(BM_Threads, springs, false)
+BENCHMARK_CAPTURE(BM_Threads, springs, ThreadedWork::Springs)
     ->ArgNames({"N", "threads"})
     ->ArgsProduct({{16, 32}, {1, 2}})
     ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
-BENCHMARK_CAPTURE(BM_Threads, rk4_step, true)
+BENCHMARK_CAPTURE(BM_Threads, rk4_step, ThreadedWork::Rk4Step)
+    ->ArgNames({"N", "threads"})
+    ->ArgsProduct({{16, 32}, {1, 2}})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_Threads, product, ThreadedWork::Product)
     ->ArgNames({"N", "threads"})
     ->ArgsProduct({{16, 32}, {1, 2}})
     ->Unit(benchmark::kMicrosecond)
