@@ -160,7 +160,8 @@ def stiff_table(r):
 
 def threads_table(r):
     lines = ["| both cores (no taskset) | 1 thread | 2 threads | speed-up |", "|---|---|---|---|"]
-    for what, label in [("springs", "every spring's force"), ("rk4_step", "a whole RK4 step")]:
+    for what, label in [("springs", "every spring's force"), ("rk4_step", "a whole RK4 step"),
+                        ("product", "the implicit solvers' matrix-free product")]:
         for n in (16, 32):
             one = r.seconds(f"BM_Threads/{what}/N:{n}/threads:1/real_time")
             two = r.seconds(f"BM_Threads/{what}/N:{n}/threads:2/real_time")
