@@ -185,13 +185,14 @@ def duration(ms):
 
 
 def crossover_table_from_json():
-    """Wall time per simulated second (BM_Crossover/<method>/<E>, k = 10^E) and each method's
-    speed-up over RK4 measured in the same run."""
+    """Wall time per simulated second (BM_Crossover/<method>/<E>, k = 10^E; medians of 3, the
+    set-up and first step timed apart) and each method's speed-up over RK4 measured in the same
+    run."""
     with open(CROSSOVER_JSON) as f:
         data = json.load(f)
     cells, order, exponents = {}, [], []
     for b in data["benchmarks"]:
-        if b.get("run_type") == "aggregate" or not b["name"].startswith("BM_Crossover/"):
+        if b.get("aggregate_name") != "median" or not b["name"].startswith("BM_Crossover/"):
             continue
         _, method, exponent = b["name"].split("/")[:3]
         method = method.replace("_", "-")
@@ -199,16 +200,16 @@ def crossover_table_from_json():
             order.append(method)
         if exponent not in exponents:
             exponents.append(exponent)
-        cells[(method, exponent)] = (milliseconds(b), b["dt_s"])
-    lines = ["| integrator | " + " | ".join(f"k = 1e{e}: per simulated second (dt)"
+        cells[(method, exponent)] = (milliseconds(b), b["dt_s"], b["setup_s"] * 1e3)
+    lines = ["| integrator | " + " | ".join(f"k = 1e{e}: per simulated second (dt; set-up)"
                                             for e in exponents) +
              " | " + " | ".join(f"speed-up over RK4 at 1e{e}" for e in exponents) + " |",
              "|---|" + "---|" * (2 * len(exponents))]
     for method in order:
         row = [label(method)]
         for e in exponents:
-            ms, dt = cells[(method, e)]
-            row.append(f"{duration(ms)} ({dt:.3g} s)")
+            ms, dt, setup = cells[(method, e)]
+            row.append(f"{duration(ms)} ({dt:.3g} s; {duration_fine(setup)})")
         for e in exponents:
             row.append(f"{cells[('rk4', e)][0] / cells[(method, e)][0]:.2g}x")
         lines.append("| " + " | ".join(row) + " |")
