@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "src/assertions.h"
+#include "src/integrator_name.h"
 
 namespace jello {
 
@@ -45,16 +46,17 @@ double Simulation::energyBudget() const {
 
 std::optional<std::string> Simulation::energyGrowth() {
   const double now = model_.energy(state_).total() - externalWork();
-  if (steps_ - envelopeStart_ <= kEnergyEnvelopeSteps) {
+  const bool swings = isExplicit(integrator_->kind());
+  if (swings && steps_ - envelopeStart_ <= kEnergyEnvelopeSteps) {
     energyEnvelope_ = std::max(energyEnvelope_, now);
     return std::nullopt;
   }
   if (now <= energyBudget()) return std::nullopt;
   std::ostringstream os;
-  os << "the energy grew to " << now << " J (energy bound " << kEnergyGrowthFactor
-     << " x its envelope " << energyEnvelope_ << " J, the largest of its first "
-     << kEnergyEnvelopeSteps << " steps, + " << kEnergyFloor
-     << " J, net of the field's and the user force's work)";
+  os << "the energy grew to " << now << " J (energy bound " << kEnergyGrowthFactor << " x its "
+     << (swings ? "envelope " : "start's ") << energyEnvelope_ << " J";
+  if (swings) os << ", the largest of its first " << kEnergyEnvelopeSteps << " steps";
+  os << ", + " << kEnergyFloor << " J, net of the field's and the user force's work)";
   return os.str();
 }
 

@@ -59,6 +59,11 @@ std::string_view integratorSummary(IntegratorKind kind) {
   return entry(kind).summary;
 }
 
+bool isExplicit(IntegratorKind kind) {
+  return kind == IntegratorKind::Euler || kind == IntegratorKind::Symplectic ||
+         kind == IntegratorKind::RK4;
+}
+
 std::span<const IntegratorKind> allIntegrators() {
   return kKinds;
 }

@@ -50,6 +50,13 @@ std::string_view integratorFileName(IntegratorKind kind);
 // One line saying what the integrator is, for help texts.
 std::string_view integratorSummary(IntegratorKind kind);
 
+// Euler, symplectic Euler and RK4: a step is one explicit formula, stable only below a step
+// size. Their energy may swing far above its start without growing (symplectic Euler's by up to
+// 1/(1 - h w/2) near h w = 2); the others are A-stable (backward Euler, BDF2 and projective damp
+// a linear system, midpoint and Newmark keep its energy) or error-controlled (CVODE), so theirs
+// has no such swing (solvers/simulation.h's divergence rule).
+bool isExplicit(IntegratorKind kind);
+
 // Every integrator, in the table's order (the viewer's number keys follow it).
 std::span<const IntegratorKind> allIntegrators();
 

@@ -7,6 +7,7 @@
 
 #include "experiments/studies/stability_analysis.h"
 #include "solvers/simulation.h"
+#include "src/integrator_name.h"
 #include "src/lattice.h"
 #include "src/scene_builder.h"
 
@@ -140,11 +141,6 @@ Attempt attempt(const World& w, IntegratorKind kind, double dt, const SolverOpti
   a.wallPerSecond = wall / setup.time;
   a.steps = sim.steps();
   return a;
-}
-
-bool isExplicit(IntegratorKind kind) {
-  return kind == IntegratorKind::Euler || kind == IntegratorKind::Symplectic ||
-         kind == IntegratorKind::RK4;
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "solvers/jacobian.h"
 #include "solvers/simulation.h"
 #include "src/contact.h"
+#include "src/integrator_name.h"
 #include "src/scene_builder.h"
 
 namespace jello::experiments {
@@ -137,8 +138,7 @@ Trial runTrial(const World& world, IntegratorKind kind, double dt, const BlowUpR
   Simulation sim(world, kind, dt, options);
   const double e0 = sim.model().energy(sim.state()).total();
   double envelope = std::max(e0, 1e-12);
-  const bool explicitMethod = kind == IntegratorKind::Euler || kind == IntegratorKind::Symplectic ||
-                              kind == IntegratorKind::RK4;
+  const bool explicitMethod = isExplicit(kind);
   const long steps = std::max(explicitMethod ? rule.minSteps : 1L, std::lround(rule.time / dt));
   Trial trial;
   for (long i = 0; i < steps; ++i) {
@@ -148,8 +148,8 @@ Trial runTrial(const World& world, IntegratorKind kind, double dt, const BlowUpR
       trial.reason = r.message;
       return trial;
     }
-    const bool inEnvelope = i < kEnergyEnvelopeSteps;
-    if (inEnvelope || (i & 3) == 3 || i + 1 == steps) {
+    const bool inEnvelope = explicitMethod && i < kEnergyEnvelopeSteps;  // implicit: the start
+    if (i < kEnergyEnvelopeSteps || (i & 3) == 3 || i + 1 == steps) {
       // Net of the work the force field (the wall scene's load) has done, as the simulation
       // counts it.
       const double e = sim.model().energy(sim.state()).total() - sim.fieldWork();

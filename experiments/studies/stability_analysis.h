@@ -51,11 +51,12 @@ World spinningStiffCube(double k, double damping, double spin = 2.0);
 
 // "Blew up": within the run, a step produced a non-finite or far state (the simulation's
 // divergence check, bound 100 m) or the total energy (kinetic + spring + contact, minus the work
-// the force field has done) rose above energyFactor times its envelope, the largest energy of
-// the first kEnergyEnvelopeSteps steps (solvers/simulation.h; the simulation applies the same
-// rule). Measured against the envelope rather than the start, a bounded oscillation cannot fire
-// it: symplectic Euler's energy swings by 1/(1 - h w/2) near h w = 2 without growing (tested at
-// h w = 1.9 over 10 s; at 2.1 it fires). The run lasts `time` simulated seconds, and explicit
+// the force field has done) rose above energyFactor times its envelope: for the explicit methods
+// the largest energy of the first kEnergyEnvelopeSteps steps, for the implicit ones the start's
+// (solvers/simulation.h; the simulation applies the same rule). Measured against the envelope
+// rather than the start, a bounded oscillation cannot fire it: symplectic Euler's energy swings
+// by 1/(1 - h w/2) near h w = 2 without growing (tested at h w = 1.9 over 10 s; at 2.1 it
+// fires). The run lasts `time` simulated seconds, and explicit
 // methods at least `minSteps` steps: just past its limit an unstable mode grows by a factor
 // barely above 1 per step, which a 0.2 s window of 20 steps (RK4 at k = 10) cannot see.
 struct BlowUpRule {
