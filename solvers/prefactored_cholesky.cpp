@@ -75,6 +75,16 @@ struct PrefactoredCholesky::Impl {
     cholmod_start(&common);
     common.print = 0;                        // failures are reported as StepResults
     common.supernodal = CHOLMOD_SUPERNODAL;  // measured: factors 3x faster than simplicial
+    // The ordering with the fewest entries in L of AMD, METIS and CHOLMOD's nested dissection,
+    // not CHOLMOD's default (AMD, and METIS only when AMD fills in badly): for projective's
+    // M/h^2 + L it kept AMD at 8^3 and 12^3, whose factors METIS makes 7% and 18% smaller (12^3:
+    // factorization 6.3 -> 4.0 ms), and METIS at 16^3, where nested dissection factors in
+    // 18 ms against 27-30 (6% fewer entries). One analysis per pattern, about twice the
+    // default's (16^3: 70 against 38 ms; 32^3: 0.8 against 0.4 s, beside 1.7 s a factorization).
+    common.nmethods = 3;
+    common.method[0].ordering = CHOLMOD_AMD;
+    common.method[1].ordering = CHOLMOD_METIS;
+    common.method[2].ordering = CHOLMOD_NESDIS;
   }
   ~Impl() {
     cholmod_free_dense(&solution, &common);
@@ -103,7 +113,8 @@ long PrefactoredCholesky::nonZeros() const {
   return nonZeros_;
 }
 
-StepResult PrefactoredCholesky::factorize(const SparseMatrix& A) {
+StepResult PrefactoredCholesky::factorize(const SparseMatrix& A,
+                                          const PrefactoredCholesky* samePattern) {
   Impl& s = *impl_;
   const int n = static_cast<int>(A.rows());
   n_ = 0;  // no factor until this one succeeds
@@ -123,6 +134,16 @@ StepResult PrefactoredCholesky::factorize(const SparseMatrix& A) {
   view.sorted = 1;
   view.packed = 1;
   if (s.symbolic && static_cast<int>(s.symbolic->n) != n) forgetPattern();
+  const cholmod_factor* lent = samePattern ? samePattern->impl_->symbolic : nullptr;
+  if (!s.symbolic && lent && static_cast<int>(lent->n) == n) {
+    // Its ordering and supernodes (and values, overwritten below).
+    s.symbolic = cholmod_copy_factor(const_cast<cholmod_factor*>(lent), &s.common);
+    if (!s.symbolic || s.common.status != CHOLMOD_OK) {
+      cholmod_free_factor(&s.symbolic, &s.common);
+      return StepResult::failure("CHOLMOD could not copy an analysis (status " +
+                                 std::to_string(s.common.status) + ")");
+    }
+  }
   if (!s.symbolic) {
     s.symbolic = cholmod_analyze(&view, &s.common);
     if (!s.symbolic || s.common.status != CHOLMOD_OK) {

@@ -120,8 +120,13 @@ StepResult ProjectiveIntegrator::factorChanged(double h) {
       }
     }
     laplacian_->form(inertia, 0.0, 1.0, weights_[c].data(), A_[c]);
-    // SPD by construction: M/h^2 > 0, L and W semidefinite.
-    const StepResult factored = factors_->llt[c].factorize(A_[c]);
+    // SPD by construction: M/h^2 > 0, L and W semidefinite. The three coordinates' matrices
+    // share one pattern: a coordinate factored for the first time borrows another's analysis.
+    const PrefactoredCholesky* analyzed = nullptr;
+    for (int e = 0; e < 3 && !analyzed; ++e) {
+      if (e != c && factors_->llt[e].factored()) analyzed = &factors_->llt[e];
+    }
+    const StepResult factored = factors_->llt[c].factorize(A_[c], analyzed);
     factorSeconds_ += secondsSince(start);
     ++factorizations_;
     if (!factored.ok) return factored.within("projective matrix");

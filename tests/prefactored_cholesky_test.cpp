@@ -73,6 +73,34 @@ TEST_P(PrefactoredCholeskyBothWays, SolvesOneTwoAndThreeRightHandSides) {
   }
 }
 
+// A factor that borrows another's analysis (projective's coordinates share one pattern) gives
+// the answer of its own: the same entries in L, the same solutions to round-off; and the lender
+// is left as it was.
+TEST_P(PrefactoredCholeskyBothWays, BorrowsAnotherFactorsAnalysis) {
+  const Model model(resampleCube(test::loadWorld("jello.w"), 6));
+  const int n = model.numPoints();
+  const SparseMatrix A = laplacianSystem(model, 3.0, 0.0);
+  SparseMatrix B = laplacianSystem(model, 3.0, 0.2);        // same pattern, other values
+  for (int p = 0; p < n; p += 5) B.coeffRef(p, p) += 50.0;  // as contact weights
+  PrefactoredCholesky lender(GetParam().copyLimit, GetParam().single);
+  PrefactoredCholesky borrower(GetParam().copyLimit, GetParam().single);
+  PrefactoredCholesky own(GetParam().copyLimit, GetParam().single);
+  ASSERT_TRUE(lender.factorize(A).ok);
+  ASSERT_TRUE(borrower.factorize(B, &lender).ok);
+  ASSERT_TRUE(own.factorize(B).ok);
+  EXPECT_EQ(borrower.nonZeros(), own.nonZeros());
+  const Eigen::MatrixXd R = Eigen::MatrixXd::Random(n, 3);
+  Eigen::MatrixXd borrowed = R, fresh = R, lent = R;
+  ASSERT_TRUE(borrower.solve(borrowed.data(), 3).ok);
+  ASSERT_TRUE(own.solve(fresh.data(), 3).ok);
+  ASSERT_TRUE(lender.solve(lent.data(), 3).ok);
+  const Eigen::MatrixXd denseB(B), denseA(A);
+  EXPECT_LT((denseB * borrowed - R).norm(), tolerance() * R.norm() * denseB.norm());
+  EXPECT_LT((borrowed - fresh).norm(), 10 * tolerance() * fresh.norm());
+  EXPECT_LT((denseA * lent - R).norm(), tolerance() * R.norm() * denseA.norm());
+  EXPECT_GT((borrowed - lent).norm(), 1e-3 * lent.norm());  // two matrices, two answers
+}
+
 TEST_P(PrefactoredCholeskyBothWays, RefusesAMatrixThatIsNotPositiveDefinite) {
   const Model model(resampleCube(test::loadWorld("jello.w"), 4));
   PrefactoredCholesky factor(GetParam().copyLimit, GetParam().single);
