@@ -1,6 +1,6 @@
 // A Cholesky factor for many cheap solves with up to three right-hand sides: the matrices whose
 // factor is kept for hundreds of solves (projective's M/h^2 + L, the projective preconditioner
-// of CG). CHOLMOD factors (supernodal, its own fill-reducing ordering); the solves then run over
+// of CG). CHOLMOD factors (supernodal, the best ordering of three); the solves then run over
 // a copy of the factor, in one of two forms by its size:
 // - up to copyLimit entries, L by rows and by columns in two plain arrays, the three
 //   right-hand sides side by side in one 4-wide vector per point and four independent
