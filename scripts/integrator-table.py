@@ -152,6 +152,8 @@ def steps_table_from_json():
             order.append(name)
         ms = b["real_time"] * {"ms": 1.0, "s": 1e3, "us": 1e-3}[b["time_unit"]]
         newton = b.get("newton_per_step")
+        if b.get("error_occurred"):  # the simulation stopped it: a divergence
+            ms, newton = None, None
         cells[(name, n.split(":")[1], spinning.split(":")[1])] = (ms, newton)
     columns = [(n, spinning) for n in ("8", "16", "32") for spinning in ("0", "1")
                if any((name, n, spinning) in cells for name in order)]
@@ -166,6 +168,9 @@ def steps_table_from_json():
                 row.append("")
                 continue
             ms, newton = cells[(name, *column)]
+            if ms is None:
+                row.append("diverges")
+                continue
             text = f"{ms:.3g} ms" if ms < 1000 else f"{ms / 1e3:.3g} s"
             row.append(text + (f" ({newton:.2g} it.)" if newton is not None else ""))
         lines.append("| " + " | ".join(row) + " |")

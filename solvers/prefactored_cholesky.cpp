@@ -54,6 +54,8 @@ void substitute(int n, const std::vector<int>& rowStart, const std::vector<int>&
 // 0.8 and 1.6 times CHOLMOD's time (kDefaultCopyLimit); the single-precision supernodes
 // (BM_KeptFactorSolve, 2026-12-03): 38, 94 and 194 us at 8^3, 10^3 and 12^3 against the copy's
 // 33, 110 and 283.
+constexpr int kOrderingsMinSize = 1000;
+
 struct PrefactoredCholesky::Impl {
   cholmod_common common{};
   cholmod_factor* symbolic = nullptr;  // analysis of the pattern, factored in place
@@ -67,6 +69,7 @@ struct PrefactoredCholesky::Impl {
   std::vector<int> inversePerm;
   std::vector<Lanes> lanes;
   std::vector<double> single;
+  int defaultOrderings[3] = {};       // cholmod_start's, restored for small matrices
   cholmod_dense* solution = nullptr;  // cholmod_solve2's outputs and work, kept between solves
   cholmod_dense* work1 = nullptr;
   cholmod_dense* work2 = nullptr;
@@ -75,16 +78,7 @@ struct PrefactoredCholesky::Impl {
     cholmod_start(&common);
     common.print = 0;                        // failures are reported as StepResults
     common.supernodal = CHOLMOD_SUPERNODAL;  // measured: factors 3x faster than simplicial
-    // The ordering with the fewest entries in L of AMD, METIS and CHOLMOD's nested dissection,
-    // not CHOLMOD's default (AMD, and METIS only when AMD fills in badly): for projective's
-    // M/h^2 + L it kept AMD at 8^3 and 12^3, whose factors METIS makes 7% and 18% smaller (12^3:
-    // factorization 6.3 -> 4.0 ms), and METIS at 16^3, where nested dissection factors in
-    // 18 ms against 27-30 (6% fewer entries). One analysis per pattern, about twice the
-    // default's (16^3: 70 against 38 ms; 32^3: 0.8 against 0.4 s, beside 1.7 s a factorization).
-    common.nmethods = 3;
-    common.method[0].ordering = CHOLMOD_AMD;
-    common.method[1].ordering = CHOLMOD_METIS;
-    common.method[2].ordering = CHOLMOD_NESDIS;
+    for (int m = 0; m < 3; ++m) defaultOrderings[m] = common.method[m].ordering;
   }
   ~Impl() {
     cholmod_free_dense(&solution, &common);
@@ -145,7 +139,25 @@ StepResult PrefactoredCholesky::factorize(const SparseMatrix& A,
     }
   }
   if (!s.symbolic) {
-    s.symbolic = cholmod_analyze(&view, &s.common);
+    // From kOrderingsMinSize the ordering with the fewest entries in L of AMD, METIS and
+    // CHOLMOD's nested dissection, instead of CHOLMOD's default (AMD, and METIS only when AMD
+    // fills in badly): for projective's M/h^2 + L the default kept AMD at 10^3 and 12^3, whose
+    // factors METIS makes 12% and 18% smaller (12^3: factorization 6.3 -> 4.0 ms), and METIS at
+    // 16^3, where nested dissection factors in 18 ms against 27-30 (6% fewer entries). The
+    // analysis costs about twice the default's (16^3: 70 against 38 ms; 32^3: 0.8 against
+    // 0.4 s, beside 1.7 s a factorization); at 8^3, 5 against 1 ms for 7% fewer entries, more
+    // than a second of projective's solves saves: the default there.
+    cholmod_common& c = s.common;
+    if (n >= kOrderingsMinSize) {
+      c.nmethods = 3;
+      c.method[0].ordering = CHOLMOD_AMD;
+      c.method[1].ordering = CHOLMOD_METIS;
+      c.method[2].ordering = CHOLMOD_NESDIS;
+    } else {
+      c.nmethods = 0;  // the default, which reads the default entries of c.method
+      for (int m = 0; m < 3; ++m) c.method[m].ordering = s.defaultOrderings[m];
+    }
+    s.symbolic = cholmod_analyze(&view, &c);
     if (!s.symbolic || s.common.status != CHOLMOD_OK) {
       cholmod_free_factor(&s.symbolic, &s.common);
       return StepResult::failure("CHOLMOD could not analyse the matrix (status " +
