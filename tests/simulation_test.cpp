@@ -110,7 +110,8 @@ TEST(Simulation, EnergyGrowthIsADivergence) {
 // conserving only on linear systems) over-stepping the stretched, spinning stiff cube by
 // h w_max = 90 gains 22x in its first step, once a growth of 800x over 20 s that the envelope of
 // its first 64 steps let through. Midpoint and backward Euler on the same scene and step (energy
-// kept 1.04 and 5e-4 over 1 s) are not flagged.
+// kept 1.04 and 5e-4 over 1 s: integrators.csv) are not flagged, checked here over the first 10
+// steps, where the rule watches every step (100 took 100 s under the sanitizers).
 TEST(Simulation, AnImplicitIntegratorsEnergyIsBoundedByItsStart) {
   const World w = test::loadWorld("spinning-k1e4.w");
   Simulation newmark(w, IntegratorKind::Newmark, 0.01);
@@ -124,7 +125,7 @@ TEST(Simulation, AnImplicitIntegratorsEnergyIsBoundedByItsStart) {
   for (IntegratorKind kind : {IntegratorKind::Midpoint, IntegratorKind::Implicit}) {
     Simulation sim(w, kind, 0.01);
     double largest = 0.0;
-    for (int i = 0; i < 100; ++i) {
+    for (int i = 0; i < 10; ++i) {
       ASSERT_TRUE(sim.step().ok) << integratorName(kind) << " step " << i;
       largest = std::max(largest, sim.model().energy(sim.state()).total());
     }
