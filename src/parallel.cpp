@@ -157,15 +157,22 @@ void runOverBasePoints(
     body(0, n, n);
     return;
   }
-  const auto runStart = [&](int t) { return t * (run + reach); };
-  runParallel(threads, [&](int t) {
-    const bool last = t + 1 == threads;
-    const std::ptrdiff_t lo = runStart(t);
-    body(lo, last ? n : lo + run, last ? n : runStart(t + 1));
-  });
+  // The split in one place, so the loop handed to the pool captures one pointer and fits in
+  // std::function's own storage (no allocation per loop).
+  struct Split {
+    std::ptrdiff_t n, reach, run;
+    int threads;
+    const std::function<void(std::ptrdiff_t, std::ptrdiff_t, std::ptrdiff_t)>& body;
+    std::ptrdiff_t start(int t) const { return t * (run + reach); }
+    void runPart(int t) const {
+      const bool last = t + 1 == threads;
+      body(start(t), last ? n : start(t) + run, last ? n : start(t + 1));
+    }
+  } const split{n, reach, run, threads, body};
+  runParallel(threads, [s = &split](int t) { s->runPart(t); });
   for (int t = 0; t + 1 < threads; ++t) {
-    const std::ptrdiff_t lo = runStart(t) + run;
-    body(lo, runStart(t + 1), lo);
+    const std::ptrdiff_t lo = split.start(t) + run;
+    body(lo, split.start(t + 1), lo);
   }
 }
 

@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <random>
+#include <utility>
 
 #include "solvers/implicit_system.h"
 #include "solvers/system_operator.h"
@@ -256,23 +257,37 @@ TEST(ImplicitSystem, SolvesTheMassMinusScaledJacobiansAtTheAssembledState) {
   }
 }
 
-// The matrix-free product through the spring groups equals the sparse matrix's, on a scene
-// with springs under every orientation and contact blocks on the diagonal.
+// A deformed world whose lower layers sink into the floor (springs under every orientation,
+// contact blocks on the diagonal): backward Euler's matrix (a = 0.01, b = 1e-4) assembled, and
+// gathered into the matrix-free product.
+struct SinkingProduct {
+  explicit SinkingProduct(World w)
+      : world(std::move(w)),
+        state(deformedJello(world)),
+        model(world),
+        op(model.springs(), model.numPoints()) {
+    state.x.tail(state.numPoints()).array() -= 2.3;
+    JacobianAssembler jac(model);
+    jac.assemble(state.x.data(), {});
+    A = jac.pattern();
+    jac.combine(0.01, 1e-4, A);
+    op.gather(A, jac.diagonalSlots(), jac.springSlots());
+  }
+  World world;
+  State state;
+  Model model;
+  SparseMatrix A;
+  SystemOperator op;
+};
+
+// The matrix-free product through the spring groups equals the sparse matrix's.
 TEST(SystemOperator, ProductEqualsTheSparseMatrix) {
-  World w = test::loadWorld("jello.w");
-  State s = deformedJello(w);
-  s.x.tail(s.numPoints()).array() -= 2.3;  // the lower layers sink into the floor
-  const Model model(w);
-  JacobianAssembler jac(model);
-  jac.assemble(s.x.data(), {});
-  SparseMatrix A = jac.pattern();
-  jac.combine(0.01, 1e-4, A);
-  SystemOperator op(model.springs(), model.numPoints());
-  op.gather(A, jac.diagonalSlots(), jac.springSlots());
+  const SinkingProduct scene(test::loadWorld("jello.w"));
+  const State& s = scene.state;
   const Eigen::VectorXd p = Eigen::VectorXd::Random(s.x.size());
   Eigen::VectorXd y(p.size());
-  op.apply(p.data(), y.data());
-  const Eigen::VectorXd expected = A * p;
+  scene.op.apply(p.data(), y.data());
+  const Eigen::VectorXd expected = scene.A * p;
   EXPECT_LT((y - expected).cwiseAbs().maxCoeff(), 1e-13 * expected.cwiseAbs().maxCoeff());
   ASSERT_LT(s.x.tail(s.numPoints()).minCoeff(), -2.0);  // some points below the floor
 }
@@ -282,18 +297,10 @@ TEST(SystemOperator, ProductEqualsTheSparseMatrix) {
 // to round-off; below it stays serial, bit for bit.
 TEST(SystemOperator, ThreadedProductEqualsTheSerialOne) {
   for (int n : {8, 16}) {
-    const World w = resampleCube(test::loadWorld("jello.w"), n);
-    State s = deformedJello(w);
-    s.x.tail(s.numPoints()).array() -= 2.3;  // the lower layers sink into the floor
-    const Model model(w);
-    JacobianAssembler jac(model);
-    jac.assemble(s.x.data(), {});
-    SparseMatrix A = jac.pattern();
-    jac.combine(0.01, 1e-4, A);
-    SystemOperator op(model.springs(), model.numPoints());
-    op.gather(A, jac.diagonalSlots(), jac.springSlots());
-    const Eigen::VectorXd p = Eigen::VectorXd::Random(s.x.size());
-    const Eigen::VectorXd expected = A * p;
+    const SinkingProduct scene(resampleCube(test::loadWorld("jello.w"), n));
+    const SystemOperator& op = scene.op;
+    const Eigen::VectorXd p = Eigen::VectorXd::Random(scene.state.x.size());
+    const Eigen::VectorXd expected = scene.A * p;
     const double scale = expected.cwiseAbs().maxCoeff();
     setParallelThreads(1);
     Eigen::VectorXd serial(p.size());
