@@ -149,31 +149,9 @@ void runParallel(int parts, const std::function<void(int)>& body) {
   for (int part = 0; part < parts; ++part) body(part);
 }
 
-void runOverBasePoints(
-    std::ptrdiff_t n, std::ptrdiff_t reach, int threads,
-    const std::function<void(std::ptrdiff_t, std::ptrdiff_t, std::ptrdiff_t)>& body) {
-  const std::ptrdiff_t run = threads > 1 ? (n - reach * (threads - 1)) / threads : n;
-  if (threads <= 1 || run <= reach) {
-    body(0, n, n);
-    return;
-  }
-  // The split in one place, so the loop handed to the pool captures one pointer and fits in
-  // std::function's own storage (no allocation per loop).
-  struct Split {
-    std::ptrdiff_t n, reach, run;
-    int threads;
-    const std::function<void(std::ptrdiff_t, std::ptrdiff_t, std::ptrdiff_t)>& body;
-    std::ptrdiff_t start(int t) const { return t * (run + reach); }
-    void runPart(int t) const {
-      const bool last = t + 1 == threads;
-      body(start(t), last ? n : start(t) + run, last ? n : start(t + 1));
-    }
-  } const split{n, reach, run, threads, body};
-  runParallel(threads, [s = &split](int t) { s->runPart(t); });
-  for (int t = 0; t + 1 < threads; ++t) {
-    const std::ptrdiff_t lo = split.start(t) + run;
-    body(lo, split.start(t + 1), lo);
-  }
+BasePointRuns splitBasePoints(std::ptrdiff_t n, std::ptrdiff_t reach, int threads) {
+  const std::ptrdiff_t run = threads > 1 ? (n - reach * (threads - 1)) / threads : 0;
+  return {n, reach, run > reach ? run : 0, threads};
 }
 
 }  // namespace jello

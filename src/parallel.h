@@ -36,9 +36,32 @@ void runParallel(int parts, const std::function<void(int)>& body);
 // ends the points the call writes first, to be set rather than added to: a run's own points and
 // the gap after it, [lo, owned); none for a gap (owned == lo), whose points and reach are the
 // runs' (written first by the run before it or after it, both done). One serial call (0, n, n)
-// for one thread, or when runs would be no longer than the gaps. body must not throw.
-void runOverBasePoints(
-    std::ptrdiff_t n, std::ptrdiff_t reach, int threads,
-    const std::function<void(std::ptrdiff_t, std::ptrdiff_t, std::ptrdiff_t)>& body);
+// for one thread, or when runs would be no longer than the gaps. body must not throw. A
+// template: the loop handed to the pool captures two references, which std::function holds
+// without allocating, whatever body captures.
+struct BasePointRuns {
+  std::ptrdiff_t n, reach, run;  // run: each run's length; 0 when serial
+  int threads;
+  std::ptrdiff_t start(int t) const { return t * (run + reach); }
+};
+BasePointRuns splitBasePoints(std::ptrdiff_t n, std::ptrdiff_t reach, int threads);
+
+template <class Body>
+void runOverBasePoints(std::ptrdiff_t n, std::ptrdiff_t reach, int threads, const Body& body) {
+  const BasePointRuns runs = splitBasePoints(n, reach, threads);
+  if (runs.run == 0) {
+    body(std::ptrdiff_t{0}, n, n);
+    return;
+  }
+  runParallel(runs.threads, [&runs, &body](int t) {
+    const bool last = t + 1 == runs.threads;
+    body(runs.start(t), last ? runs.n : runs.start(t) + runs.run,
+         last ? runs.n : runs.start(t + 1));
+  });
+  for (int t = 0; t + 1 < runs.threads; ++t) {
+    const std::ptrdiff_t lo = runs.start(t) + runs.run;
+    body(lo, runs.start(t + 1), lo);
+  }
+}
 
 }  // namespace jello
