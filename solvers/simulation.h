@@ -68,7 +68,10 @@ class Simulation {
   void setIntegrator(IntegratorKind kind, const SolverOptions& options);
   // The state, for editing in place (the Python module's numpy views write into it). Its
   // vectors must keep their size. Call stateEdited() after a change, before the next step.
-  State& editableState() { return state_; }
+  State& editableState() {
+    verified_ = false;
+    return state_;
+  }
   // The state was changed from outside: the integrator starts afresh (no history, as after a
   // user force), the energy rule takes the new energy as its start, and a divergence is
   // forgotten when the state is sane again.
@@ -102,6 +105,7 @@ class Simulation {
   Model model_;
   State state_;
   State previous_;
+  bool verified_ = false;  // state_ was checked finite and has not been handed out since
   SolverOptions options_;
   std::unique_ptr<Integrator> integrator_;
   double dt_;

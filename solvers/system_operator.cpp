@@ -72,22 +72,25 @@ void SystemOperator::apply(const double* p, double* y) const {
   // Split over threads as the spring forces are (src/parallel.h): every group's springs write
   // to their base points and partners at most maxDelta_ points further.
   const int threads = n_ >= kParallelMinPoints ? parallelThreads() : 1;
-  runOverBasePoints(n_, maxDelta_, threads,
-                    [&](std::ptrdiff_t lo, std::ptrdiff_t hi, std::ptrdiff_t owned) {
-                      applyRange(p, y, lo, hi, owned);
-                    });
+  runOverPointBlocks(
+      splitPointBlocks(n_, maxDelta_, threads),
+      [&](std::ptrdiff_t setLo, std::ptrdiff_t setHi, std::ptrdiff_t lo, std::ptrdiff_t hi) {
+        applyRange(p, y, setLo, setHi, lo, hi);
+      },
+      [](std::ptrdiff_t, std::ptrdiff_t) {});
 }
 
-void SystemOperator::applyRange(const double* p, double* y, std::ptrdiff_t lo, std::ptrdiff_t hi,
-                                std::ptrdiff_t owned) const {
+void SystemOperator::applyRange(const double* p, double* y, std::ptrdiff_t setLo,
+                                std::ptrdiff_t setHi, std::ptrdiff_t lo, std::ptrdiff_t hi) const {
   const std::ptrdiff_t n = n_;
   const double *px = p, *py = p + n, *pz = p + 2 * n;
   double *yx = y, *yy = y + n, *yz = y + 2 * n;
-  // The points' own blocks first (y = G p) over the points this call owns, then every spring's
+  // The points' own blocks first (y = G p) over the points this call sets, then every spring's
   // with a base point in [lo, hi), both ends.
-  for (int c = 0; c < 3; ++c) std::fill(y + c * n + lo, y + c * n + owned, 0.0);
-  if (owned > lo) {
-    addBlockProducts(owned - lo, diag_, lo, px + lo, py + lo, pz + lo, yx + lo, yy + lo, yz + lo);
+  for (int c = 0; c < 3; ++c) std::fill(y + c * n + setLo, y + c * n + setHi, 0.0);
+  if (setHi > setLo) {
+    addBlockProducts(setHi - setLo, diag_, setLo, px + setLo, py + setLo, pz + setLo, yx + setLo,
+                     yy + setLo, yz + setLo);
   }
   for (const Group& g : groups_) {
     const std::ptrdiff_t begin = std::clamp<std::ptrdiff_t>(lo - g.first, 0, g.count);

@@ -47,10 +47,10 @@ class SystemOperator {
     std::vector<double> mask;              // 1 where the slot is a spring
     std::array<std::vector<double>, 6> c;  // the spring's block of A, upper triangle
   };
-  // y = A p's terms of the springs with a base point in [lo, hi), and of the points' own
-  // blocks in [lo, owned), which it sets first (src/parallel.h, runOverBasePoints).
-  void applyRange(const double* p, double* y, std::ptrdiff_t lo, std::ptrdiff_t hi,
-                  std::ptrdiff_t owned) const;
+  // y = A p's terms of the points' own blocks in [setLo, setHi), which it sets first, then of
+  // the springs with a base point in [lo, hi) (src/parallel.h, runOverPointBlocks).
+  void applyRange(const double* p, double* y, std::ptrdiff_t setLo, std::ptrdiff_t setHi,
+                  std::ptrdiff_t lo, std::ptrdiff_t hi) const;
   std::vector<Group> groups_;
   std::array<std::vector<double>, 6> diag_;
   int n_ = 0;

@@ -23,22 +23,24 @@ double* blockOf(double* diag, int p) {
 // The loops below are branch-free (selects, an OR reduction) so that they vectorize: they run
 // in every force evaluation.
 
-bool WallContact::allInside(const double* __restrict x, int n) {
+bool WallContact::allInside(const double* __restrict x, int n, int lo, int hi) {
   int outside = 0;
-  for (int i = 0; i < 3 * n; ++i) outside |= std::abs(x[i]) > kBoxHalfSize;
+  for (int e = 0; e < 3; ++e)
+    for (int i = e * n + lo; i < e * n + hi; ++i) outside |= std::abs(x[i]) > kBoxHalfSize;
   return outside == 0;
 }
 
 void WallContact::accumulate(const double* __restrict x, const double* __restrict v,
-                             double* __restrict f, int n) const {
+                             double* __restrict f, int n, int lo, int hi) const {
   // Each component is its own pair of walls: normal -/+ e_c, so the spring acts on that
   // component alone.
   const double k = k_.stiffness, c = k_.damping;
-  for (int i = 0; i < 3 * n; ++i) {
-    const double over = x[i] - kBoxHalfSize, under = x[i] + kBoxHalfSize;
-    const double depth = over > 0.0 ? over : under < 0.0 ? under : 0.0;
-    f[i] -= depth != 0.0 ? k * depth + c * v[i] : 0.0;
-  }
+  for (int e = 0; e < 3; ++e)
+    for (int i = e * n + lo; i < e * n + hi; ++i) {
+      const double over = x[i] - kBoxHalfSize, under = x[i] + kBoxHalfSize;
+      const double depth = over > 0.0 ? over : under < 0.0 ? under : 0.0;
+      f[i] -= depth != 0.0 ? k * depth + c * v[i] : 0.0;
+    }
 }
 
 double WallContact::energy(const double* x, int n) const {
@@ -70,10 +72,10 @@ PlaneContact::PlaneContact(const Plane& plane, ContactConstants k) : k_(k) {
 }
 
 void PlaneContact::accumulate(const double* __restrict x, const double* __restrict v,
-                              double* __restrict f, int n) const {
+                              double* __restrict f, int n, int lo, int hi) const {
   const double ux = normal_.x, uy = normal_.y, uz = normal_.z;
   const double k = k_.stiffness, c = k_.damping;
-  for (int p = 0; p < n; ++p) {
+  for (int p = lo; p < hi; ++p) {
     const double dist = ux * x[p] + uy * x[n + p] + uz * x[2 * n + p] + offset_;
     const double vn = ux * v[p] + uy * v[n + p] + uz * v[2 * n + p];
     const double s = dist < 0.0 ? -k * dist - c * vn : 0.0;
@@ -102,10 +104,11 @@ void PlaneContact::addJacobian(const double* x, int n, JacobianBlocks& out) cons
   }
 }
 
-void SphereContact::accumulate(const double* x, const double* v, double* f, int n) const {
+void SphereContact::accumulate(const double* x, const double* v, double* f, int n, int lo,
+                               int hi) const {
   const Vec3 c = sphere_.center;
   const double r = sphere_.radius;
-  for (int p = 0; p < n; ++p) {
+  for (int p = lo; p < hi; ++p) {
     const Vec3 d{x[p] - c.x, x[n + p] - c.y, x[2 * n + p] - c.z};
     const double l2 = dot(d, d);
     if (l2 >= r * r) continue;

@@ -18,14 +18,19 @@ struct ContactConstants {
   double damping = 0.0;    // N*s/m (dCollision)
 };
 
-// All arrays component-major, n points.
+// All arrays component-major, n points. The forces' range versions add those of the points
+// [lo, hi) only (Model splits them over threads).
 class WallContact {
  public:
   explicit WallContact(ContactConstants k) : k_(k) {}
   const ContactConstants& constants() const { return k_; }
-  // True when every point is inside the box, so there is nothing to do.
-  static bool allInside(const double* x, int n);
-  void accumulate(const double* x, const double* v, double* f, int n) const;
+  // True when every point (of [lo, hi)) is inside the box, so there is nothing to do.
+  static bool allInside(const double* x, int n) { return allInside(x, n, 0, n); }
+  static bool allInside(const double* x, int n, int lo, int hi);
+  void accumulate(const double* x, const double* v, double* f, int n) const {
+    accumulate(x, v, f, n, 0, n);
+  }
+  void accumulate(const double* x, const double* v, double* f, int n, int lo, int hi) const;
   double energy(const double* x, int n) const;
   // K = -kc e_c e_c^T, D = -dc e_c e_c^T on the diagonal block of each violated wall's point.
   void addJacobian(const double* x, int n, JacobianBlocks& out) const;
@@ -37,7 +42,10 @@ class WallContact {
 class PlaneContact {
  public:
   PlaneContact(const Plane& plane, ContactConstants k);
-  void accumulate(const double* x, const double* v, double* f, int n) const;
+  void accumulate(const double* x, const double* v, double* f, int n) const {
+    accumulate(x, v, f, n, 0, n);
+  }
+  void accumulate(const double* x, const double* v, double* f, int n, int lo, int hi) const;
   double energy(const double* x, int n) const;
   // K = -kc n n^T, D = -dc n n^T for each point on the solid side.
   void addJacobian(const double* x, int n, JacobianBlocks& out) const;
@@ -56,7 +64,10 @@ class SphereContact {
   SphereContact(const Sphere& sphere, ContactConstants k) : sphere_(sphere), k_(k) {}
   const Sphere& sphere() const { return sphere_; }
   const ContactConstants& constants() const { return k_; }
-  void accumulate(const double* x, const double* v, double* f, int n) const;
+  void accumulate(const double* x, const double* v, double* f, int n) const {
+    accumulate(x, v, f, n, 0, n);
+  }
+  void accumulate(const double* x, const double* v, double* f, int n, int lo, int hi) const;
   double energy(const double* x, int n) const;
   // For each point inside, n radial: K = -kc n n^T + kc (R/l - 1)(I - n n^T) (the second term
   // is the surface's curvature; positive, so the clamp drops it), D = -dc n n^T.

@@ -85,16 +85,16 @@ void FieldForces::gradient(const Vec3& position, double out[3][3]) const {
       }
 }
 
-void FieldForces::accumulate(const double* x, double* f, int n) const {
+void FieldForces::accumulate(const double* x, double* f, int n, int lo, int hi) const {
   if (uniform_) {
-    for (int p = 0; p < n; ++p) {
+    for (int p = lo; p < hi; ++p) {
       f[p] += constant_.x;
       f[n + p] += constant_.y;
       f[2 * n + p] += constant_.z;
     }
     return;
   }
-  for (int p = 0; p < n; ++p) {
+  for (int p = lo; p < hi; ++p) {
     const Vec3 F = sample({x[p], x[n + p], x[2 * n + p]});
     f[p] += F.x;
     f[n + p] += F.y;

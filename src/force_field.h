@@ -18,8 +18,10 @@ class FieldForces {
   // dF_a/dx_b (N/m), row a, column b: the derivative of the trilinear interpolant inside the
   // cell, zero along an axis where the position is clamped. Not symmetric in general.
   void gradient(const Vec3& position, double out[3][3]) const;
-  // Adds the field force at each of the n points (component-major x) to f.
-  void accumulate(const double* x, double* f, int n) const;
+  // Adds the field force at each of the n points (component-major x) to f; the second, at the
+  // points [lo, hi) only.
+  void accumulate(const double* x, double* f, int n) const { accumulate(x, f, n, 0, n); }
+  void accumulate(const double* x, double* f, int n, int lo, int hi) const;
   // Adds gradient() to each point's diagonal block of K (only with out.includeField).
   void addJacobian(const double* x, int n, JacobianBlocks& out) const;
 

@@ -46,35 +46,35 @@ Model::Model(ModelSpec spec)
 void Model::forces(const double* x, const double* v, double* f) const {
   std::fill(f, f + 3 * n_, 0.0);
   springs_.accumulate(x, v, f);
-  counters_->springs.fetch_add(1, std::memory_order_relaxed);
-  if (walls_) {
-    if (WallContact::allInside(x, n_)) {
-      counters_->wallsSkipped.fetch_add(1, std::memory_order_relaxed);
-    } else {
-      walls_->accumulate(x, v, f, n_);
-      counters_->walls.fetch_add(1, std::memory_order_relaxed);
-    }
-  }
-  if (plane_) {
-    plane_->accumulate(x, v, f, n_);
-    counters_->plane.fetch_add(1, std::memory_order_relaxed);
-  }
-  if (sphere_) {
-    sphere_->accumulate(x, v, f, n_);
-    counters_->sphere.fetch_add(1, std::memory_order_relaxed);
-  }
-  for (const ObstacleContact& o : obstacles_) {
-    o.accumulate(x, v, f, n_);
-    counters_->obstacles.fetch_add(1, std::memory_order_relaxed);
-  }
-  if (field_) {
-    field_->accumulate(x, f, n_);
-    counters_->field.fetch_add(1, std::memory_order_relaxed);
-  }
+  countEvaluation(addPointForces(x, v, f, 0, n_));
+}
+
+bool Model::addPointForces(const double* x, const double* v, double* f, int lo, int hi) const {
+  const int n = n_;
+  const bool walls = walls_ && !WallContact::allInside(x, n, lo, hi);
+  if (walls) walls_->accumulate(x, v, f, n, lo, hi);
+  if (plane_) plane_->accumulate(x, v, f, n, lo, hi);
+  if (sphere_) sphere_->accumulate(x, v, f, n, lo, hi);
+  for (const ObstacleContact& o : obstacles_) o.accumulate(x, v, f, n, lo, hi);
+  if (field_) field_->accumulate(x, f, n, lo, hi);
   if (userForce_) {
-    for (int i = 0; i < 3 * n_; ++i) f[i] += (*userForce_)[i];
-    counters_->user.fetch_add(1, std::memory_order_relaxed);
+    const double* u = userForce_->data();
+    for (int e = 0; e < 3; ++e)
+      for (int i = e * n + lo; i < e * n + hi; ++i) f[i] += u[i];
   }
+  return walls;
+}
+
+void Model::countEvaluation(bool wallsEvaluated) const {
+  const auto count = [](std::atomic<long>& c) { c.fetch_add(1, std::memory_order_relaxed); };
+  Counters& c = *counters_;
+  count(c.springs);
+  if (walls_) count(wallsEvaluated ? c.walls : c.wallsSkipped);
+  if (plane_) count(c.plane);
+  if (sphere_) count(c.sphere);
+  for (std::size_t i = 0; i < obstacles_.size(); ++i) count(c.obstacles);
+  if (field_) count(c.field);
+  if (userForce_) count(c.user);
 }
 
 EffectCounts Model::counts() const {
@@ -93,6 +93,35 @@ void Model::acceleration(const double* x, const double* v, double* a) const {
   forces(x, v, a);
   const double inv = 1.0 / mass_;
   for (int i = 0; i < 3 * n_; ++i) a[i] *= inv;
+}
+
+void Model::acceleration(const double* x, const double* v, double* a, PointRangeRef then) const {
+  const PointBlocks blocks = pointBlocks();
+  if (blocks.threads == 1) {
+    acceleration(x, v, a);
+    then(0, n_);
+    return;
+  }
+  // The springs in the two phases of src/parallel.h, then on each thread's block the rest of
+  // the forces, the division by the mass and then().
+  const std::ptrdiff_t n = n_;
+  std::atomic<bool> walls{false};  // evaluated on some block
+  const double inv = 1.0 / mass_;
+  runOverPointBlocks(
+      blocks,
+      [&](std::ptrdiff_t setLo, std::ptrdiff_t setHi, std::ptrdiff_t lo, std::ptrdiff_t hi) {
+        for (std::ptrdiff_t e = 0; e < 3; ++e) std::fill(a + e * n + setLo, a + e * n + setHi, 0.0);
+        springs_.accumulateRange(x, v, a, lo, hi);
+      },
+      [&](std::ptrdiff_t lo, std::ptrdiff_t hi) {
+        if (addPointForces(x, v, a, static_cast<int>(lo), static_cast<int>(hi))) {
+          walls.store(true, std::memory_order_relaxed);
+        }
+        for (std::ptrdiff_t e = 0; e < 3; ++e)
+          for (std::ptrdiff_t i = e * n + lo; i < e * n + hi; ++i) a[i] *= inv;
+        then(lo, hi);
+      });
+  countEvaluation(walls.load(std::memory_order_relaxed));
 }
 
 void Model::forces(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& f) const {

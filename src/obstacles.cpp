@@ -149,8 +149,9 @@ std::optional<Penetration> ObstacleContact::penetration(const Vec3& x) const {
   return cone_ ? conePenetration(*cone_, x) : spiralPenetration(*spiral_, x);
 }
 
-void ObstacleContact::accumulate(const double* x, const double* v, double* f, int n) const {
-  for (int p = 0; p < n; ++p) {
+void ObstacleContact::accumulate(const double* x, const double* v, double* f, int n, int lo,
+                                 int hi) const {
+  for (int p = lo; p < hi; ++p) {
     const std::optional<Penetration> q = penetration(at(x, n, p));
     if (!q) continue;
     const Vec3 nrm = unitVector(q->gradient * -1.0);

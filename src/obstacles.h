@@ -37,7 +37,11 @@ class ObstacleContact {
   const ContactConstants& constants() const { return k_; }
   std::optional<Penetration> penetration(const Vec3& x) const;
   bool inside(const Vec3& x) const { return penetration(x).has_value(); }
-  void accumulate(const double* x, const double* v, double* f, int n) const;
+  void accumulate(const double* x, const double* v, double* f, int n) const {
+    accumulate(x, v, f, n, 0, n);
+  }
+  // The points [lo, hi) only.
+  void accumulate(const double* x, const double* v, double* f, int n, int lo, int hi) const;
   double energy(const double* x, int n) const;
   void addJacobian(const double* x, int n, JacobianBlocks& out) const;
 

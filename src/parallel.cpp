@@ -149,9 +149,9 @@ void runParallel(int parts, const std::function<void(int)>& body) {
   for (int part = 0; part < parts; ++part) body(part);
 }
 
-BasePointRuns splitBasePoints(std::ptrdiff_t n, std::ptrdiff_t reach, int threads) {
-  const std::ptrdiff_t run = threads > 1 ? (n - reach * (threads - 1)) / threads : 0;
-  return {n, reach, run > reach ? run : 0, threads};
+PointBlocks splitPointBlocks(std::ptrdiff_t n, std::ptrdiff_t reach, int threads) {
+  const bool split = threads > 1 && n / threads / 2 >= reach;
+  return {n, reach, split ? threads : 1};
 }
 
 }  // namespace jello

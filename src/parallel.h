@@ -1,13 +1,16 @@
 // Both cores for the model's large loops (README "Speed"): a small pool of worker threads that
-// runs the parts of one loop at once. Only the spring forces and energy use it, and only from
-// kParallelMinPoints points up, where a loop is long enough (milliseconds) to pay for waking a
-// thread and for the worker's spinning beside the step's serial rest. The pool is shared by the
+// runs the parts of one loop at once. The model's forces (with an explicit step's updates fused
+// in, Model::acceleration), the springs' energy, the simulation's per-step checks and the
+// implicit solvers' matrix-free product use it, the model only from kParallelMinPoints points
+// up, where a loop is long enough (milliseconds) to pay for waking a thread and for the
+// worker's spinning beside the step's serial rest. The pool is shared by the
 // process: a caller that finds it busy (another thread's loop, an experiment's parallel grid)
 // runs its parts itself, one after another.
 #pragma once
 
 #include <cstddef>
 #include <functional>
+#include <type_traits>
 
 namespace jello {
 
@@ -30,38 +33,63 @@ void setParallelThreads(int threads);
 void runParallel(int parts, const std::function<void(int)>& body);
 
 // A loop over the base points [0, n) of springs (or of their matrix blocks) that writes to each
-// base point and to partners at most `reach` points after it, split over `threads`: [0, n) is cut
-// into `threads` runs separated by gaps of `reach` points, so no two runs write the same point,
-// and body(lo, hi, owned) runs for the runs at once, then for the gaps one after another. `owned`
-// ends the points the call writes first, to be set rather than added to: a run's own points and
-// the gap after it, [lo, owned); none for a gap (owned == lo), whose points and reach are the
-// runs' (written first by the run before it or after it, both done). One serial call (0, n, n)
-// for one thread, or when runs would be no longer than the gaps. body must not throw. A
-// template: the loop handed to the pool captures two references, which std::function holds
-// without allocating, whatever body captures.
-struct BasePointRuns {
-  std::ptrdiff_t n, reach, run;  // run: each run's length; 0 when serial
+// base point and to partners at most `reach` points after it, split over threads with no serial
+// part. Thread t owns the points [begin(t), end(t)), cut in halves at middle(t); the work runs in
+// two phases, the threads of each at once.
+//   Phase 0: each thread first sets (rather than adds to) the points only it writes in this
+//   phase, [setBegin(t), setEnd(t)): its block but its first `reach` points, and the next
+//   block's first `reach` points; then it runs the base points of its second half, whose writes
+//   reach the next block's first `reach` points at most.
+//   Phase 1: each thread runs the base points of its first half, whose writes stay in its block;
+//   after that every write to its block is done, and after(begin(t), end(t)) runs there.
+// One thread (serial) when a half would be shorter than reach.
+struct PointBlocks {
+  std::ptrdiff_t n, reach;
   int threads;
-  std::ptrdiff_t start(int t) const { return t * (run + reach); }
+  std::ptrdiff_t begin(int t) const { return n * t / threads; }
+  std::ptrdiff_t end(int t) const { return n * (t + 1) / threads; }
+  std::ptrdiff_t middle(int t) const { return (begin(t) + end(t)) / 2; }
+  std::ptrdiff_t setBegin(int t) const { return t == 0 ? 0 : begin(t) + reach; }
+  std::ptrdiff_t setEnd(int t) const { return t + 1 == threads ? n : end(t) + reach; }
 };
-BasePointRuns splitBasePoints(std::ptrdiff_t n, std::ptrdiff_t reach, int threads);
+PointBlocks splitPointBlocks(std::ptrdiff_t n, std::ptrdiff_t reach, int threads);
 
-template <class Body>
-void runOverBasePoints(std::ptrdiff_t n, std::ptrdiff_t reach, int threads, const Body& body) {
-  const BasePointRuns runs = splitBasePoints(n, reach, threads);
-  if (runs.run == 0) {
-    body(std::ptrdiff_t{0}, n, n);
+// Runs the phases above: body(setLo, setHi, lo, hi) sets the points [setLo, setHi) and then adds
+// the terms of the base points [lo, hi); after(lo, hi) follows on each block once it is done.
+// Serial: body(0, n, 0, n), after(0, n). Neither may throw. A template: the loops handed to the
+// pool capture at most two references, which std::function holds without allocating.
+template <class Body, class After>
+void runOverPointBlocks(const PointBlocks& blocks, const Body& body, const After& after) {
+  if (blocks.threads == 1) {
+    body(std::ptrdiff_t{0}, blocks.n, std::ptrdiff_t{0}, blocks.n);
+    after(std::ptrdiff_t{0}, blocks.n);
     return;
   }
-  runParallel(runs.threads, [&runs, &body](int t) {
-    const bool last = t + 1 == runs.threads;
-    body(runs.start(t), last ? runs.n : runs.start(t) + runs.run,
-         last ? runs.n : runs.start(t + 1));
+  runParallel(blocks.threads, [&blocks, &body](int t) {
+    body(blocks.setBegin(t), blocks.setEnd(t), blocks.middle(t), blocks.end(t));
   });
-  for (int t = 0; t + 1 < runs.threads; ++t) {
-    const std::ptrdiff_t lo = runs.start(t) + runs.run;
-    body(lo, runs.start(t + 1), lo);
-  }
+  const auto firstHalves = [&blocks, &body, &after](int t) {
+    body(blocks.begin(t), blocks.begin(t), blocks.begin(t), blocks.middle(t));
+    after(blocks.begin(t), blocks.end(t));
+  };
+  runParallel(blocks.threads, [&firstHalves](int t) { firstHalves(t); });
 }
+
+// A reference to a callable body(lo, hi) over a range of points, for a function that is not a
+// template to take a lambda (std::function would allocate for one that captures much). The
+// callable must outlive the call.
+class PointRangeRef {
+ public:
+  template <class F, class = std::enable_if_t<!std::is_same_v<std::decay_t<F>, PointRangeRef>>>
+  PointRangeRef(const F& body)  // NOLINT(google-explicit-constructor): taken as an argument
+      : body_(&body), call_([](const void* b, std::ptrdiff_t lo, std::ptrdiff_t hi) {
+          (*static_cast<const F*>(b))(lo, hi);
+        }) {}
+  void operator()(std::ptrdiff_t lo, std::ptrdiff_t hi) const { call_(body_, lo, hi); }
+
+ private:
+  const void* body_;
+  void (*call_)(const void*, std::ptrdiff_t, std::ptrdiff_t);
+};
 
 }  // namespace jello

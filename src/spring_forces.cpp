@@ -137,14 +137,18 @@ void subtractFromPartners(std::ptrdiff_t count, const double* __restrict gx,
 }  // namespace
 
 void SpringForces::accumulate(const double* x, const double* v, double* f) const {
-  // The base points in runs separated by gaps of maxDelta_ points (src/parallel.h): at 32^3 the
-  // gaps, serial, are 6% of the points. The sums differ from the serial ones only in the order
-  // in which a few points receive their terms (round-off).
-  const int threads = n_ >= kParallelMinPoints ? parallelThreads() : 1;
-  runOverBasePoints(n_, maxDelta_, threads,
-                    [&](std::ptrdiff_t lo, std::ptrdiff_t hi, std::ptrdiff_t) {
-                      accumulateRange(x, v, f, lo, hi);
-                    });
+  // Each thread's block of base points in two halves (src/parallel.h): the sums differ from the
+  // serial ones only in the order in which points receive their terms (round-off).
+  runOverPointBlocks(
+      splitPointBlocks(n_, maxDelta_, threads()),
+      [&](std::ptrdiff_t, std::ptrdiff_t, std::ptrdiff_t lo, std::ptrdiff_t hi) {
+        accumulateRange(x, v, f, lo, hi);
+      },
+      [](std::ptrdiff_t, std::ptrdiff_t) {});
+}
+
+int SpringForces::threads() const {
+  return n_ >= kParallelMinPoints ? parallelThreads() : 1;
 }
 
 void SpringForces::accumulateRange(const double* x, const double* v, double* f, std::ptrdiff_t lo,
@@ -190,7 +194,7 @@ void SpringForces::accumulateRange(const double* x, const double* v, double* f, 
 }
 
 double SpringForces::energy(const double* x) const {
-  const int threads = n_ >= kParallelMinPoints ? parallelThreads() : 1;
+  const int threads = this->threads();
   if (threads <= 1) return energyRange(x, 0, 1);
   // Both cores from 32^3 (the divergence check's energy is as long as a force evaluation): each
   // part sums every group over its share of the base points; the parts' sums are then added in

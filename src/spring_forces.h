@@ -55,15 +55,23 @@ class SpringForces {
   // x-derivative of spring damping (not symmetric) is left out, as Baraff & Witkin do.
   void addJacobian(const double* x, JacobianBlocks& out) const;
 
+  // The springs whose base point is in [lo, hi) (both ends' forces), on the calling thread:
+  // for a caller that splits the work itself (Model), as accumulate does, by runOverPointBlocks
+  // with reach() and the threads accumulate would use, threads().
+  void accumulateRange(const double* x, const double* v, double* f, std::ptrdiff_t lo,
+                       std::ptrdiff_t hi) const;
+  // The largest offset from a spring's base point to its partner.
+  int reach() const { return maxDelta_; }
+  // The threads accumulate splits its work over: parallelThreads() from kParallelMinPoints
+  // points up, else 1.
+  int threads() const;
+
   int numSprings() const { return numSprings_; }
   const std::vector<SpringGroup>& groups() const { return groups_; }
   // The same springs as a plain list (Jacobian assembly, drawing, tests).
   std::vector<Spring> springs() const;
 
  private:
-  // The springs whose base point is in [lo, hi) (both ends' forces).
-  void accumulateRange(const double* x, const double* v, double* f, std::ptrdiff_t lo,
-                       std::ptrdiff_t hi) const;
   // The energy of part `part` of `parts` of each group's springs.
   double energyRange(const double* x, int part, int parts) const;
 

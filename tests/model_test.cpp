@@ -3,11 +3,15 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cstddef>
 #include <random>
+#include <string>
 #include <thread>
 #include <vector>
 
+#include "src/parallel.h"
 #include "src/scene_builder.h"
 #include "tests/test_support.h"
 
@@ -102,6 +106,60 @@ TEST(Model, EnergyAddsKineticSpringAndContact) {
   EXPECT_NEAR(e.contact, 0.5 * 400 * 0.1 * 0.1, 1e-12);
   EXPECT_GT(e.spring, 0.0);
   EXPECT_DOUBLE_EQ(e.total(), e.kinetic + e.spring + e.contact);
+}
+
+// The acceleration fused with a step's update (RK4 uses it) is split over threads by point
+// ranges from 32^3 up: with every effect at work (walls on one side only, plane, sphere, field,
+// user force) it equals the serial acceleration to round-off, hands each point to then() once,
+// and counts each effect once.
+TEST(Model, ThreadedAccelerationThenEqualsTheSerialOne) {
+  World w = resampleCube(test::loadWorld("rotate.w"), 32);  // a field
+  State s = initialState(w);
+  const int n = w.cubeResolution * w.cubeResolution * w.cubeResolution;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> jitter(-0.01, 0.01);
+  for (Eigen::Index i = 0; i < s.x.size(); ++i) {
+    s.x[i] += jitter(rng);
+    s.v[i] = 10.0 * jitter(rng);
+  }
+  // Into the +x wall: only the last points (the largest i) are outside.
+  s.x.head(n).array() += kBoxHalfSize + 0.05 - s.x.head(n).maxCoeff();
+  const Vec3 c{s.x.head(n).mean(), s.x.segment(n, n).mean(), s.x.tail(n).mean()};
+  w.plane = Plane{0.3, 0.2, 1.0, -(0.3 * c.x + 0.2 * c.y + c.z)};  // through the centre
+  w.sphere = Sphere{c, 0.3};
+  Model model(w);
+  model.setUserForce(Eigen::VectorXd::LinSpaced(3 * n, -1.0, 1.0));
+  ASSERT_GT(model.walls()->energy(s.x.data(), n), 0.0);
+  ASSERT_GT(model.plane()->energy(s.x.data(), n), 0.0);
+  ASSERT_GT(model.sphere()->energy(s.x.data(), n), 0.0);
+  ASSERT_GT(s.x.head(n).minCoeff(), -kBoxHalfSize);
+  setParallelThreads(1);
+  Eigen::VectorXd serial(3 * n);
+  model.acceleration(s.x.data(), s.v.data(), serial.data());
+  for (int threads : {1, 2, 3}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    setParallelThreads(threads);
+    const EffectCounts before = model.counts();
+    std::vector<int> visits(static_cast<std::size_t>(n), 0);
+    Eigen::VectorXd a = Eigen::VectorXd::Constant(3 * n, 1e300);  // a missed zeroing shows
+    model.acceleration(s.x.data(), s.v.data(), a.data(), [&](std::ptrdiff_t lo, std::ptrdiff_t hi) {
+      for (std::ptrdiff_t p = lo; p < hi; ++p) ++visits[static_cast<std::size_t>(p)];
+    });
+    EXPECT_LE((a - serial).cwiseAbs().maxCoeff(), 1e-12 * serial.cwiseAbs().maxCoeff());
+    if (threads == 1) {
+      EXPECT_EQ(a, serial);
+    }
+    EXPECT_EQ(std::count(visits.begin(), visits.end(), 1), n);
+    const EffectCounts after = model.counts();
+    EXPECT_EQ(after.springs - before.springs, 1);
+    EXPECT_EQ(after.walls - before.walls, 1);
+    EXPECT_EQ(after.wallsSkipped, before.wallsSkipped);
+    EXPECT_EQ(after.plane - before.plane, 1);
+    EXPECT_EQ(after.sphere - before.sphere, 1);
+    EXPECT_EQ(after.field - before.field, 1);
+    EXPECT_EQ(after.user - before.user, 1);
+  }
+  setParallelThreads(1);
 }
 
 // Model::forces is const and keeps no scratch: two threads evaluating one model at different

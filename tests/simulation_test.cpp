@@ -5,7 +5,10 @@
 
 #include <algorithm>
 #include <limits>
+#include <string>
 
+#include "src/parallel.h"
+#include "src/scene_builder.h"
 #include "src/world_reader.h"
 #include "src/world_writer.h"
 #include "tests/test_support.h"
@@ -61,6 +64,33 @@ TEST(Simulation, FindsNonFiniteValuesAndFarPoints) {
   State far = s;
   far.x[7] = -150.0;
   EXPECT_TRUE(findDivergence(far).has_value());
+}
+
+// From 32^3 the step's copy of its start and its divergence check run on the model's threads,
+// each on its own points: a point thrown out of the box is found in the first thread's points
+// and in the last's, and the state kept is the step's start, bit for bit.
+TEST(Simulation, FindsDivergenceInEveryThreadsPoints) {
+  const World w = resampleCube(test::loadWorld("jello.w"), 32);
+  for (int threads : {1, 2}) {
+    setParallelThreads(threads);
+    const int n = 32 * 32 * 32;
+    for (int p : {0, n / 2 - 1, n / 2, n - 1}) {
+      SCOPED_TRACE(std::to_string(threads) + " threads, point " + std::to_string(p));
+      Simulation s(w, IntegratorKind::RK4, 1e-4);
+      ASSERT_EQ(s.model().pointBlocks().threads, threads);
+      ASSERT_TRUE(s.step().ok);
+      s.editableState().v[p] = 1e7;  // 1 km in a step: past the 100 m bound
+      s.stateEdited();
+      const State start = s.state();
+      const StepResult r = s.step();
+      ASSERT_FALSE(r.ok);
+      EXPECT_NE(r.message.find("m from the origin"), std::string::npos) << r.message;
+      EXPECT_EQ(s.state().x, start.x);
+      EXPECT_EQ(s.state().v, start.v);
+      EXPECT_EQ(s.state().t, start.t);
+    }
+  }
+  setParallelThreads(1);
 }
 
 TEST(Simulation, FindsFastPointsAndFarPointsByTheirDistance) {
