@@ -116,8 +116,8 @@ StepResult Simulation::step() {
     verified_ = true;
   }
   // previous_ = state_, and below the divergence check, on the threads the model splits its
-  // points over, each on its own points: at 32^3 these passes on one thread took a tenth of a
-  // two-thread RK4 step, and as long again reading what the other core had written.
+  // points over, each on its own points: on one thread these passes would be serial and read
+  // what the other core wrote in the step (the blocks are those RK4's updates run on).
   const PointBlocks blocks = model_.pointBlocks();
   previous_.t = state_.t;
   previous_.x.resize(state_.x.size());
