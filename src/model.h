@@ -77,10 +77,11 @@ class Model {
   void acceleration(const double* x, const double* v, double* a) const;
   // The same, then then(lo, hi) on ranges of points whose acceleration is final, each point in
   // one range: a step's update of those points fused with the evaluation. From
-  // kParallelMinPoints points up the work is split over threads by the springs' runs
-  // (src/parallel.h): a thread computes its points' forces, contact and acceleration and runs
-  // then() on them, so what one stage writes stays in that core's cache for the next (updates
-  // on one thread between threaded evaluations made a 32^3 RK4 step little faster on two).
+  // kParallelMinPoints points up the work is split over threads by blocks of points
+  // (src/parallel.h, runOverPointBlocks): a thread computes its block's forces, contact and
+  // acceleration and runs then() on them, so what one stage writes stays in that core's cache
+  // for the next (updates on one thread between threaded evaluations made a 32^3 RK4 step
+  // little faster on two).
   // then() may write x and v at [lo, hi) (no longer read there), and nothing outside it.
   void acceleration(const double* x, const double* v, double* a, PointRangeRef then) const;
   // The same on Eigen vectors; the output is resized.
