@@ -44,9 +44,7 @@ Model::Model(ModelSpec spec)
 }
 
 void Model::forces(const double* x, const double* v, double* f) const {
-  std::fill(f, f + 3 * n_, 0.0);
-  springs_.accumulate(x, v, f);
-  countEvaluation(addPointForces(x, v, f, 0, n_));
+  evaluate(x, v, f, 1.0, [](std::ptrdiff_t, std::ptrdiff_t) {});
 }
 
 bool Model::addPointForces(const double* x, const double* v, double* f, int lo, int hi) const {
@@ -90,35 +88,33 @@ void Model::setUserForce(const Eigen::VectorXd& f) {
 }
 
 void Model::acceleration(const double* x, const double* v, double* a) const {
-  forces(x, v, a);
-  const double inv = 1.0 / mass_;
-  for (int i = 0; i < 3 * n_; ++i) a[i] *= inv;
+  evaluate(x, v, a, 1.0 / mass_, [](std::ptrdiff_t, std::ptrdiff_t) {});
 }
 
 void Model::acceleration(const double* x, const double* v, double* a, PointRangeRef then) const {
-  const PointBlocks blocks = pointBlocks();
-  if (blocks.threads == 1) {
-    acceleration(x, v, a);
-    then(0, n_);
-    return;
-  }
-  // The springs in the two phases of src/parallel.h, then on each thread's block the rest of
-  // the forces, the division by the mass and then().
+  evaluate(x, v, a, 1.0 / mass_, then);
+}
+
+void Model::evaluate(const double* x, const double* v, double* f, double scale,
+                     PointRangeRef then) const {
+  // The springs in the two phases of src/parallel.h (one serial call below kParallelMinPoints),
+  // then on each thread's block the rest of the forces, the scaling and then().
   const std::ptrdiff_t n = n_;
   std::atomic<bool> walls{false};  // evaluated on some block
-  const double inv = 1.0 / mass_;
   runOverPointBlocks(
-      blocks,
+      pointBlocks(),
       [&](std::ptrdiff_t setLo, std::ptrdiff_t setHi, std::ptrdiff_t lo, std::ptrdiff_t hi) {
-        for (std::ptrdiff_t e = 0; e < 3; ++e) std::fill(a + e * n + setLo, a + e * n + setHi, 0.0);
-        springs_.accumulateRange(x, v, a, lo, hi);
+        for (std::ptrdiff_t e = 0; e < 3; ++e) std::fill(f + e * n + setLo, f + e * n + setHi, 0.0);
+        springs_.accumulateRange(x, v, f, lo, hi);
       },
       [&](std::ptrdiff_t lo, std::ptrdiff_t hi) {
-        if (addPointForces(x, v, a, static_cast<int>(lo), static_cast<int>(hi))) {
+        if (addPointForces(x, v, f, static_cast<int>(lo), static_cast<int>(hi))) {
           walls.store(true, std::memory_order_relaxed);
         }
-        for (std::ptrdiff_t e = 0; e < 3; ++e)
-          for (std::ptrdiff_t i = e * n + lo; i < e * n + hi; ++i) a[i] *= inv;
+        if (scale != 1.0) {
+          for (std::ptrdiff_t e = 0; e < 3; ++e)
+            for (std::ptrdiff_t i = e * n + lo; i < e * n + hi; ++i) f[i] *= scale;
+        }
         then(lo, hi);
       });
   countEvaluation(walls.load(std::memory_order_relaxed));

@@ -71,7 +71,7 @@ class Model {
 
   // f = total force (N) at state (x, v); all arrays 3n, component-major. The model keeps no
   // scratch: several threads may evaluate one model at once (only its counters change, and
-  // they are atomic).
+  // they are atomic). Split over threads as the acceleration with then() below is.
   void forces(const double* x, const double* v, double* f) const;
   // a = f / m (m/s^2).
   void acceleration(const double* x, const double* v, double* a) const;
@@ -162,6 +162,10 @@ class Model {
   }
 
  private:
+  // f = scale x (the forces at (x, v)), then then() on each block of points once f is final
+  // there: forces() and both acceleration()s.
+  void evaluate(const double* x, const double* v, double* f, double scale,
+                PointRangeRef then) const;
   // Adds every effect but the springs at the points [lo, hi) to f; false when the walls were
   // skipped there (all points inside the box).
   bool addPointForces(const double* x, const double* v, double* f, int lo, int hi) const;
