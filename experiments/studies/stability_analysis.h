@@ -30,7 +30,8 @@ namespace jello::experiments {
 using jello::maxAngularFrequency;
 
 // The largest h at which `kind` is stable on every mode up to wMax with damping ratio
-// r * w / 2 (r = c/k in s); 0 when never stable, +infinity for implicit and cvode.
+// r * w / 2 (r = c/k in s); 0 when never stable, +infinity for the implicit methods and cvode
+// (A-stable on the linear equation; nonlinear springs can still make them blow up, measured).
 double predictedThreshold(IntegratorKind kind, double wMax, double dampingRatio);
 
 // The standard scenes, spring damping c = r k:

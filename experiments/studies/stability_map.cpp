@@ -83,8 +83,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1L, 100000000L))
       ->capture_default_str();
   app.add_option("--energy-factor", opt.rule.energyFactor,
-                 "Blow-up when the total energy exceeds this times its envelope (the largest "
-                 "energy of the first 64 steps)")
+                 "Blow-up when the total energy exceeds this times its envelope: the largest "
+                 "energy of the first 64 steps for explicit methods, the start's for implicit ones")
       ->check(jello::cli::range(1.0, 1e12))
       ->capture_default_str();
   app.add_option("--tolerance", opt.tolerance, "Bisection stops at unstable/stable <= 1 + this")
