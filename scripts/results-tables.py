@@ -28,7 +28,8 @@ from readme_blocks import replace_block  # noqa: E402
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RESULTS = os.path.join(ROOT, "experiments", "results")
 README = os.path.join(ROOT, "README.md")
-ORDER = ["rk4", "symplectic", "euler", "implicit", "cvode"]
+ORDER = ["rk4", "symplectic", "euler", "implicit", "cvode", "implicit-linear", "midpoint",
+         "newmark", "bdf2", "projective"]
 
 
 def read_rows(name):
@@ -65,8 +66,9 @@ def stability_summary():
     lines = [
         f"Blow-up rule of this run: {rule['time_s']:g} simulated s (explicit methods at least "
         f"{rule.get('explicit_min_steps', 0)} steps), energy above {rule['energy_factor']:g} "
-        f"times its envelope (the largest of the first {rule.get('energy_envelope_steps', 0)} "
-        f"steps), or a point {rule['divergence_bound_m']:g} m out; bisection to "
+        f"times its envelope (explicit methods: the largest of the first "
+        f"{rule.get('energy_envelope_steps', 0)} steps; implicit ones and cvode: the start's), "
+        f"or a point {rule['divergence_bound_m']:g} m out; bisection to "
         f"{100 * sidecar['parameters']['bisection_tolerance']:g}%; commit "
         f"{sidecar['commit'][:7]}{' (modified tree)' if sidecar.get('tree_modified') else ''}, "
         f"{sidecar['date_utc'][:10]}.",
@@ -87,6 +89,18 @@ def stability_summary():
                 lines.append(f"| {scene} | {name} | never blew up up to dt = "
                              f"{float(measured[0]['dt_s']):g} s | up to {courant.split('-')[-1]} "
                              f"| none | {zeta} |")
+                continue
+            if all(points[k]["predicted"]["outcome"] == "unconditional" for k in ks):
+                # Stable on the linear equation at every step, yet blew up on the scene.
+                def threshold(m):
+                    return ("stable to the largest dt" if m["outcome"] == "stable_to_max"
+                            else f"{float(m['courant_number']):.2f}")
+                detail = ", ".join(f"{k_text(k)}: {threshold(points[k]['measured'])}"
+                                   for k in ks)
+                blew = [float(points[k]["measured"]["courant_number"]) for k in ks
+                        if points[k]["measured"]["outcome"] != "stable_to_max"]
+                lines.append(f"| {scene} | {name} | none predicted; blew up past h w_max "
+                             f"(k = {detail}) | {span(blew)} | none | {zeta} |")
                 continue
             ratio = [float(points[k]["measured"]["dt_s"]) / float(points[k]["predicted"]["dt_s"])
                      for k in ks]
