@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "solvers/jacobian.h"
+#include "src/parallel.h"
 
 namespace jello {
 
@@ -29,13 +30,12 @@ class SystemOperator {
               const std::vector<int>& springSlots);
 
   // y = A p, both 3n component-major; y is overwritten, and must not alias p. Split over
-  // threads from kParallelMinPoints points, as the spring forces are from 32^3 (round-off apart
-  // from the serial sum).
+  // threads from kParallelMinPoints points, as the spring forces are (round-off apart from the
+  // serial sum).
   void apply(const double* p, double* y) const;
-  // From 16^3, unlike the forces: CG's serial rest between two products (a few vector updates)
-  // is short. Measured at 16^3 on two threads (BM_Threads, BM_CgSolve): the product 1.43x, a
-  // Jacobi-CG solve 1.25x faster.
-  static constexpr int kParallelMinPoints = 16 * 16 * 16;
+  // Measured at 16^3 on two threads (BM_Threads, BM_CgSolve): the product 1.43x, a Jacobi-CG
+  // solve 1.25x faster.
+  static constexpr int kParallelMinPoints = jello::kParallelMinPoints;
 
   // Each point's diagonal block of A as 6 arrays of n (xx, xy, xz, yy, yz, zz): block-Jacobi.
   const std::array<std::vector<double>, 6>& diagonalBlocks() const { return diag_; }

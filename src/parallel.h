@@ -14,10 +14,12 @@
 
 namespace jello {
 
-// Measured (experiments/results/speed_threads.json): at 16^3 the spring forces ran 1.35x faster
-// on two threads but a whole RK4 step 0.87x slower (the waiting worker and the serial rest of the
-// step share the VM's two CPUs); at 32^3 1.86x and 1.42x.
-inline constexpr int kParallelMinPoints = 32 * 32 * 32;
+// From 16^3 (BM_Threads, experiments/results/speed_threads.json): with each thread running the
+// whole evaluation and the integrator's update on its own block (runOverPointBlocks), a 16^3 RK4
+// step is no longer slower on two threads (it was 0.87x when only the springs were split) and
+// its spring forces gain 1.5x; at 8^3 a loop takes a few microseconds, as long as waking and
+// joining a thread.
+inline constexpr int kParallelMinPoints = 16 * 16 * 16;
 
 // The most threads a loop is ever split over (JELLO_THREADS and setParallelThreads are clamped).
 inline constexpr int kMaxParallelThreads = 64;

@@ -66,9 +66,9 @@ TEST(Simulation, FindsNonFiniteValuesAndFarPoints) {
   EXPECT_TRUE(findDivergence(far).has_value());
 }
 
-// From 32^3 the step's copy of its start and its divergence check run on the model's threads,
-// each on its own points: a point thrown out of the box is found in the first thread's points
-// and in the last's, and the state kept is the step's start, bit for bit.
+// From 16^3 (kParallelMinPoints) the step's copy of its start and its divergence check run on
+// the model's threads, each on its own points: a point thrown out of the box is found in the
+// first thread's points and in the last's, and the state kept is the step's start, bit for bit.
 TEST(Simulation, FindsDivergenceInEveryThreadsPoints) {
   const World w = resampleCube(test::loadWorld("jello.w"), 32);
   for (int threads : {1, 2}) {
