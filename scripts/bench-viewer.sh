@@ -2,7 +2,9 @@
 # Frames per second of the viewer at 640x480 under Xvfb (Mesa's software renderer), with 4x
 # multisampling and the panel open, the simulation on its own thread in real time:
 #   jello.w, RK4 at the world's dt, shaded and wireframe (the simulation keeps up);
-#   cube16.w with cvode (the simulation lags far behind: the drawing must not).
+#   cube16.w with cvode (the simulation lags far behind: the drawing must not);
+#   cube16.w with RK4 as the viewer runs it (its loops on one CPU fewer than there are:
+#   src/parallel.h, leaveOneCpuFree) and with JELLO_THREADS=2.
 # Pinned to one core for the drawing's figure (`taskset -c 0,1` leaves the simulation thread
 # the other). Writes experiments/results/viewer_fps.json; `scripts/viewer-table.py --readme`
 # puts it in the README.   scripts/bench-viewer.sh [FRAMES]
@@ -19,13 +21,17 @@ bench() {  # name, world, args...
   shift 2
   echo "bench-viewer: $name" >&2
   local line
-  line=$(xvfb-run -a -s "-screen 0 1024x768x24" build/release/bin/jello "$world" "$@")
+  line=$(env ${BENCH_ENV:-} xvfb-run -a -s "-screen 0 1024x768x24" build/release/bin/jello \
+    "$world" "$@")
   echo "$line" >&2
   printf '%s\t%s\n' "$name" "$line" >>"$tmp"
 }
 bench jello-rk4-shaded worlds/jello.w --integrator rk4 --benchmark "$frames"
 bench jello-rk4-wireframe worlds/jello.w --integrator rk4 --benchmark "$frames" --wireframe
 bench cube16-cvode-shaded worlds/cube16.w --integrator cvode --benchmark $((frames / 4))
+bench cube16-rk4-shaded worlds/cube16.w --integrator rk4 --benchmark $((frames / 4))
+BENCH_ENV=JELLO_THREADS=2 bench cube16-rk4-shaded-2threads worlds/cube16.w --integrator rk4 \
+  --benchmark $((frames / 4))
 python3 - "$tmp" "$out" "$(git rev-parse --short HEAD)$(git diff --quiet HEAD -- viewer src solvers || echo -dirty)" <<'PY'
 import json, os, re, sys
 rows = {}

@@ -14,6 +14,8 @@ LABELS = {
     "jello-rk4-shaded": "jello.w, rk4, shaded",
     "jello-rk4-wireframe": "jello.w, rk4, wireframe",
     "cube16-cvode-shaded": "cube16.w, cvode, shaded",
+    "cube16-rk4-shaded": "cube16.w, rk4, shaded (the viewer's default: its loops on one CPU)",
+    "cube16-rk4-shaded-2threads": "cube16.w, rk4, shaded, `JELLO_THREADS=2`",
 }
 
 

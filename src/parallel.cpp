@@ -15,15 +15,24 @@ namespace jello {
 
 namespace {
 
-int defaultThreads() {
-  if (const char* env = std::getenv("JELLO_THREADS")) {
-    const int t = std::atoi(env);
-    if (t >= 1) return std::min(t, kMaxParallelThreads);
-  }
+// JELLO_THREADS's value, or 0 when it is unset or not a positive number.
+int environmentThreads() {
+  const char* env = std::getenv("JELLO_THREADS");
+  const int t = env ? std::atoi(env) : 0;
+  return t >= 1 ? std::min(t, kMaxParallelThreads) : 0;
+}
+
+// The CPUs this process may run on, at most 8.
+int cpuThreads() {
   cpu_set_t set;
   int cpus = 1;
   if (sched_getaffinity(0, sizeof set, &set) == 0) cpus = CPU_COUNT(&set);
   return std::clamp(cpus, 1, 8);
+}
+
+int defaultThreads() {
+  const int t = environmentThreads();
+  return t > 0 ? t : cpuThreads();
 }
 
 std::atomic<int> configuredThreads{0};  // 0: not decided yet
@@ -142,6 +151,10 @@ int parallelThreads() {
 
 void setParallelThreads(int threads) {
   configuredThreads.store(std::clamp(threads, 1, kMaxParallelThreads), std::memory_order_relaxed);
+}
+
+void leaveOneCpuFree() {
+  if (environmentThreads() == 0) setParallelThreads(std::max(1, cpuThreads() - 1));
 }
 
 void runParallel(int parts, const std::function<void(int)>& body) {

@@ -29,6 +29,12 @@ inline constexpr int kMaxParallelThreads = 64;
 int parallelThreads();
 // Sets it for the whole process (tests, benchmarks): 1 makes every loop serial.
 void setParallelThreads(int threads);
+// Unless JELLO_THREADS is set, splits loops over one CPU fewer than the process may run on (at
+// least one): for a program whose other thread is busy all the time, as the viewer's drawing is.
+// A loop's parts wait for each other, so a part whose CPU the other thread holds stalls them all:
+// on two CPUs the viewer simulated a 16^3 cube with RK4 many times slower on two threads than on
+// one (experiments/results/viewer_fps.json).
+void leaveOneCpuFree();
 
 // Runs body(part) for part in [0, parts): part 0 on the calling thread, the others on the pool's
 // workers; returns when all are done. body must not throw.

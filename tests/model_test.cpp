@@ -2,10 +2,12 @@
 #include "src/model.h"
 
 #include <gtest/gtest.h>
+#include <sched.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <thread>
@@ -158,6 +160,30 @@ TEST(Model, ThreadedAccelerationThenEqualsTheSerialOne) {
     EXPECT_EQ(after.sphere - before.sphere, 1);
     EXPECT_EQ(after.field - before.field, 1);
     EXPECT_EQ(after.user - before.user, 1);
+  }
+  setParallelThreads(1);
+}
+
+// The viewer's setting (its drawing thread is busy all the time): loops split over one CPU fewer
+// than the process may run on, at least one; JELLO_THREADS, when set, decides instead.
+TEST(Parallel, LeavingOneCpuFreeSplitsOverOneFewerUnlessJelloThreadsIsSet) {
+  cpu_set_t set;
+  ASSERT_EQ(sched_getaffinity(0, sizeof set, &set), 0);
+  const int cpus = std::min(CPU_COUNT(&set), 8);
+  const char* env = std::getenv("JELLO_THREADS");
+  const std::string saved = env ? env : "";
+  ::unsetenv("JELLO_THREADS");
+  setParallelThreads(7);
+  leaveOneCpuFree();
+  EXPECT_EQ(parallelThreads(), std::max(1, cpus - 1));
+  ::setenv("JELLO_THREADS", "3", 1);
+  setParallelThreads(5);
+  leaveOneCpuFree();
+  EXPECT_EQ(parallelThreads(), 5);  // left as it was
+  if (env) {
+    ::setenv("JELLO_THREADS", saved.c_str(), 1);
+  } else {
+    ::unsetenv("JELLO_THREADS");
   }
   setParallelThreads(1);
 }

@@ -13,6 +13,7 @@
 #include "solvers/solver_threads.h"
 #include "src/finite_options.h"
 #include "src/out_of_memory.h"
+#include "src/parallel.h"
 #include "src/world_reader.h"
 #include "viewer/texture.h"
 #include "viewer/viewer_app.h"
@@ -34,6 +35,7 @@ std::filesystem::path defaultWorld() {
 int main(int argc, char** argv) {
   jello::exitCleanlyWhenOutOfMemory("jello");
   jello::applySolverThreadSettings(argv);
+  jello::leaveOneCpuFree();  // the drawing thread's (src/parallel.h)
   jello::viewer::ViewerOptions opt;
   std::string world = defaultWorld().string(), integrator, size = "640x480";
   CLI::App app{"jello: the interactive jello cube (OpenGL/GLUT viewer)"};
