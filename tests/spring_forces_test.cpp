@@ -114,10 +114,10 @@ TEST(SpringForces, RK4OnTwoThreadsKeepsAFreeSpinningCubesMomentaAndEnergy) {
 
 // Both cores (src/parallel.h): the threaded evaluation splits the points into one block per
 // thread, each run in two halves; it equals the serial sum to round-off, for 2 and 3 threads, at
-// 32^3 on a deformed moving cube, as do the springs' energy and a whole RK4 step. Below
-// kParallelMinPoints (16^3) each is the serial result, bit for bit.
+// 16^3 and 32^3 on a deformed moving cube, as do the springs' energy and a whole RK4 step. Below
+// kParallelMinPoints (16^3: at 8^3) each is the serial result, bit for bit.
 TEST(SpringForces, ThreadedEvaluationEqualsTheSerialOne) {
-  for (int n : {16, 32}) {
+  for (int n : {8, 16, 32}) {
     const World w = resampleCube(test::loadWorld("jello.w"), n);
     const Model model(w);
     State s = initialState(w);
