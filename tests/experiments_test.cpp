@@ -5,6 +5,7 @@
 #include <Spectra/SymEigsSolver.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -23,6 +24,7 @@
 #include "experiments/studies/stability_analysis.h"
 #include "solvers/jacobian.h"
 #include "solvers/simulation.h"
+#include "src/parallel.h"
 #include "src/scene_builder.h"
 #include "tests/experiments_support.h"
 #include "tests/test_support.h"
@@ -352,6 +354,19 @@ TEST(CsvTable, RowsAreInTaskOrderWhateverTheThreadsAndSurviveAGather) {
   EXPECT_EQ(even.text(), expected);
   EXPECT_EQ(even.rows(), 25u);
   EXPECT_THROW(even.merge("3 x 1,2\n"), std::runtime_error);
+}
+
+// Several jobs hold the CPUs: their tasks' model loops run on the task's thread, and the setting
+// comes back after; one job leaves it alone.
+TEST(ParallelFor, JobsKeepTheModelsLoopsOnTheirOwnThread) {
+  setParallelThreads(2);
+  std::atomic<int> threaded{0};
+  parallelFor(4, 2, "", false, [&](int) { threaded += parallelThreads() > 1; });
+  EXPECT_EQ(threaded, 0);
+  EXPECT_EQ(parallelThreads(), 2);
+  parallelFor(2, 1, "", false, [&](int) { threaded += parallelThreads() > 1; });
+  EXPECT_EQ(threaded, 2);
+  setParallelThreads(1);
 }
 
 TEST(Ranks, WithoutAnMpiLauncherTheProcessIsTheOnlyRankAndRunsEveryTask) {

@@ -11,6 +11,7 @@
 
 #include "experiments/common/progress.h"
 #include "experiments/studies/csv_table.h"
+#include "src/parallel.h"
 
 namespace jello::experiments {
 
@@ -37,6 +38,8 @@ void parallelFor(const std::vector<int>& tasks, int jobs, const std::string& lab
       ++done;
     }
   };
+  const int modelThreads = parallelThreads();
+  if (jobs > 1) setParallelThreads(1);
   std::vector<std::thread> threads;
   for (int t = 1; t < std::max(1, jobs); ++t) threads.emplace_back(worker);
   // The calling thread works too, and draws the progress line between its tasks.
@@ -56,6 +59,7 @@ void parallelFor(const std::vector<int>& tasks, int jobs, const std::string& lab
   finished = true;
   if (reporter.joinable()) reporter.join();
   bar.finish();
+  setParallelThreads(modelThreads);
   if (failure) std::rethrow_exception(failure);
 }
 

@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "experiments/studies/parallel_for.h"
+#include "src/parallel.h"
 
 #ifdef JELLO_HAVE_MPI
 #include <mpi.h>
@@ -71,6 +72,8 @@ void Ranks::setUp() {
         "MPI_Comm_split_type");
   check(MPI_Comm_size(local, &localSize_), "MPI_Comm_size");
   check(MPI_Comm_free(&local), "MPI_Comm_free");
+  // The node's CPUs are shared by its ranks: the model's loops split over this rank's share.
+  if (localSize_ > 1) setParallelThreads(std::max(1, parallelThreads() / localSize_));
 #endif
 }
 
