@@ -7,6 +7,7 @@
 #include <string>
 
 #include "solvers/blas_headroom.h"
+#include "solvers/dense_tail.h"
 #include "solvers/diagonal_correction.h"
 #include "solvers/single_supernodes.h"
 
@@ -16,14 +17,27 @@ namespace {
 // Three right-hand sides and a pad, one vector register (AVX) per point.
 using Lanes = double __attribute__((vector_size(32)));
 
+// The entries of one right-hand side (T = double) or of the first `columns` of three (T = four
+// lanes).
+inline double& lane(double& y, int) {
+  return y;
+}
+inline double& lane(Lanes& y, int c) {
+  return reinterpret_cast<double*>(&y)[c];
+}
+
 // Forward substitution L y = y by rows, then backward L^T z = y by columns, in place; T is one
 // double or four lanes. Each row's sum runs over four accumulators: the additions of one row
-// are independent, so the loop is bound by loads, not by the adder's latency.
+// are independent, so the loop is bound by loads, not by the adder's latency. The rows and
+// columns from tailStart on are the dense tail's (its entries are not in the copy): their rows'
+// sums over the columns before it come first, then the tail's own forward and backward
+// substitutions over `work`, side by side, then the columns before it.
 template <typename T>
 void substitute(int n, const std::vector<int>& rowStart, const std::vector<int>& rowColumn,
                 const std::vector<double>& rowValue, const std::vector<int>& colStart,
                 const std::vector<int>& colRow, const std::vector<double>& colValue,
-                const std::vector<double>& inverseDiagonal, T* y) {
+                const std::vector<double>& inverseDiagonal, int tailStart, const DenseTail& tail,
+                int columns, double* work, T* y) {
   const auto sweep = [y](const int* index, const double* value, int begin, int end, T sum) {
     T s1 = sum - sum, s2 = s1, s3 = s1;  // zero, for both T
     int q = begin;
@@ -36,11 +50,24 @@ void substitute(int n, const std::vector<int>& rowStart, const std::vector<int>&
     for (; q < end; ++q) sum -= value[q] * y[index[q]];
     return (sum + s1) + (s2 + s3);
   };
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < tailStart; ++i) {
     y[i] = sweep(rowColumn.data(), rowValue.data(), rowStart[i], rowStart[i + 1], y[i]) *
            inverseDiagonal[i];
   }
-  for (int j = n - 1; j >= 0; --j) {
+  if (tailStart < n) {
+    for (int i = tailStart; i < n; ++i) {
+      y[i] = sweep(rowColumn.data(), rowValue.data(), rowStart[i], rowStart[i + 1], y[i]);
+    }
+    const int width = tail.paddedWidth();
+    std::fill_n(work, static_cast<long>(columns) * width, 0.0);
+    for (int i = tailStart; i < n; ++i)
+      for (int c = 0; c < columns; ++c) work[c * width + i - tailStart] = lane(y[i], c);
+    tail.forward(work, columns);
+    tail.backward(work, columns);
+    for (int i = tailStart; i < n; ++i)
+      for (int c = 0; c < columns; ++c) lane(y[i], c) = work[c * width + i - tailStart];
+  }
+  for (int j = tailStart - 1; j >= 0; --j) {
     y[j] = sweep(colRow.data(), colValue.data(), colStart[j], colStart[j + 1], y[j]) *
            inverseDiagonal[j];
   }
@@ -69,6 +96,8 @@ struct PrefactoredCholesky::Impl {
   std::vector<int> inversePerm;
   std::vector<Lanes> lanes;
   std::vector<double> single;
+  DenseTail tail;                     // the copy's last supernodes, when it pays (dense_tail.h)
+  std::vector<double> tailBlock;      // its triangle from an updated factor, by columns
   int defaultOrderings[3] = {};       // cholmod_start's, restored for small matrices
   cholmod_dense* solution = nullptr;  // cholmod_solve2's outputs and work, kept between solves
   cholmod_dense* work1 = nullptr;
@@ -205,14 +234,20 @@ StepResult PrefactoredCholesky::factorize(const SparseMatrix& A,
   }
   if (!s.copied) return StepResult::success();
   // Copy the supernodes' dense column blocks into L by columns, dropping the explicit zeros
-  // of merged supernodes; then transpose into L by rows.
+  // of merged supernodes; then transpose into L by rows. The last supernodes go to the dense
+  // tail instead, when it pays.
   inverseDiagonal_.assign(static_cast<std::size_t>(n), 0.0);
   colStart_.assign(static_cast<std::size_t>(n) + 1, 0);
   colRow_.clear();
   colValue_.clear();
+  tailStart_ = s.tail.copyTail(*L, n);
   for (std::size_t sn = 0; sn < L->nsuper; ++sn) {
     const int first = super[sn], last = super[sn + 1];
     const int height = pi[sn + 1] - pi[sn];
+    if (first >= tailStart_) {
+      for (int j = first; j < last; ++j) colStart_[static_cast<std::size_t>(j) + 1] = colStart_[j];
+      continue;
+    }
     for (int j = first; j < last; ++j) {
       const int jj = j - first;
       const double* column = values + px[sn] + static_cast<std::ptrdiff_t>(jj) * height;
@@ -317,7 +352,11 @@ StepResult PrefactoredCholesky::addToDiagonal(const std::vector<std::pair<int, d
     }
   }
   if (!s.copied) return StepResult::success();
-  // The copy from the simplicial LDL' factor, as LL': column j scaled by sqrt(D_j).
+  // The copy from the simplicial LDL' factor, as LL': column j scaled by sqrt(D_j); the columns
+  // of the dense tail (chosen at the factorization: same ordering, and no entry of theirs lies
+  // above it) into its triangle.
+  const int tail = tailStart_, width = n - tail;
+  s.tailBlock.assign(static_cast<std::size_t>(width) * width, 0.0);
   const cholmod_factor& L = *s.updated;
   const auto* Lp = static_cast<const int*>(L.p);
   const auto* Li = static_cast<const int*>(L.i);
@@ -334,13 +373,20 @@ StepResult PrefactoredCholesky::addToDiagonal(const std::vector<std::pair<int, d
     }
     const double root = std::sqrt(d);
     inverseDiagonal_[static_cast<std::size_t>(j)] = 1.0 / root;
-    for (int q = Lp[j] + 1; q < Lp[j] + Lnz[j]; ++q) {
-      if (Lx[q] == 0.0) continue;
-      colRow_.push_back(Li[q]);
-      colValue_.push_back(Lx[q] * root);
+    if (j >= tail) {
+      double* column = s.tailBlock.data() + static_cast<std::ptrdiff_t>(j - tail) * width;
+      column[j - tail] = root;
+      for (int q = Lp[j] + 1; q < Lp[j] + Lnz[j]; ++q) column[Li[q] - tail] = Lx[q] * root;
+    } else {
+      for (int q = Lp[j] + 1; q < Lp[j] + Lnz[j]; ++q) {
+        if (Lx[q] == 0.0) continue;
+        colRow_.push_back(Li[q]);
+        colValue_.push_back(Lx[q] * root);
+      }
     }
     colStart_[static_cast<std::size_t>(j) + 1] = static_cast<int>(colRow_.size());
   }
+  if (tail < n) s.tail.copy(s.tailBlock.data(), width);
   transposeCopy();
   return StepResult::success();
 }
@@ -375,7 +421,7 @@ StepResult PrefactoredCholesky::solveFactored(double* b, int columns) const {
     double* y = s.single.data();
     for (int k = 0; k < n; ++k) y[k] = b[perm_[k]];
     substitute(n, rowStart_, rowColumn_, rowValue_, colStart_, colRow_, colValue_, inverseDiagonal_,
-               y);
+               tailStart_, s.tail, 1, s.tail.workspace(), y);
     for (int k = 0; k < n; ++k) b[perm_[k]] = y[k];
     return StepResult::success();
   }
@@ -385,7 +431,7 @@ StepResult PrefactoredCholesky::solveFactored(double* b, int columns) const {
     y[k] = Lanes{b[p], columns > 1 ? b[n + p] : 0.0, columns > 2 ? b[2 * n + p] : 0.0, 0.0};
   }
   substitute(n, rowStart_, rowColumn_, rowValue_, colStart_, colRow_, colValue_, inverseDiagonal_,
-             y);
+             tailStart_, s.tail, columns, s.tail.workspace(), y);
   for (int k = 0; k < n; ++k) {
     const int p = perm_[k];
     b[p] = y[k][0];

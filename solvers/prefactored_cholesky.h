@@ -5,8 +5,10 @@
 // - up to copyLimit entries, L by rows and by columns in two plain arrays, the three
 //   right-hand sides side by side in one 4-wide vector per point and four independent
 //   accumulators per row, so every entry of L is read once per triangle for all three columns
-//   and no chain of dependent additions limits the loop. Measured at 8^3 (512 points, 42,000
-//   entries in L): a solve for three columns takes about half of CHOLMOD's own supernodal solve.
+//   and no chain of dependent additions limits the loop; the factor's last supernodes (at 8^3
+//   263 of 512 columns, 61% of L) as one dense triangle (solvers/dense_tail.h), read eight
+//   entries to a vector. Measured at 8^3 (512 points, 48,000 entries in L, three columns): 20
+//   us, against 32 us for the copy without the tail and about 77 us for CHOLMOD's own solve.
 // - above (10^3 points and more: the copy and its indices no longer stay in cache), CHOLMOD's
 //   dense supernodes copied in single precision and solved by our own blocked substitutions
 //   (solvers/single_supernodes.h),
@@ -16,7 +18,8 @@
 //   condition number): what a preconditioner or projective's fixed-point iterations need, whose
 //   residuals are evaluated in double. singlePrecision = false solves these by CHOLMOD.
 // After addToDiagonal, single-precision factors are solved with a low-rank correction, the others
-// over CHOLMOD's updates of a simplicial copy (large ones by CHOLMOD) until the next factorize.
+// over CHOLMOD's updates of a simplicial copy (copied again, the dense tail too; large ones by
+// CHOLMOD) until the next factorize.
 // Solves allocate nothing after the first.
 #pragma once
 
@@ -79,6 +82,7 @@ class PrefactoredCholesky {
   int n_ = 0;
   long nonZeros_ = 0;
   std::vector<int> perm_;  // row k of the factor is point perm_[k]
+  int tailStart_ = 0;      // the copy's columns from here on are the dense tail's
   std::vector<double> inverseDiagonal_;
   std::vector<int> rowStart_, rowColumn_;  // strictly lower L by rows
   std::vector<double> rowValue_;

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "solvers/dense_tail.h"
 #include "src/model.h"
 #include "src/scene_builder.h"
 #include "tests/test_support.h"
@@ -155,6 +156,34 @@ TEST_P(PrefactoredCholeskyBothWays, UpdatesAndDowndatesTheDiagonal) {
 // it (solvers/diagonal_correction.h): as close to a factorization of the changed matrix as the
 // factor itself is to the original, over rounds that add points, change them again and take
 // some back out (the correction then shrinks), and cleared by the next factorization.
+// The dense tail (solvers/dense_tail.h) on its own: a lower triangle of 21 columns (two whole
+// panels and a padded one) solves L y = b and L' y = b like Eigen's triangular solves, one to
+// three right-hand sides at once.
+TEST(DenseTail, SolvesBothTrianglesLikeEigen) {
+  const int w = 21;
+  Eigen::MatrixXd L = Eigen::MatrixXd::Random(w, w).triangularView<Eigen::StrictlyLower>();
+  L.diagonal() = Eigen::VectorXd::LinSpaced(w, 2.0, 5.0);
+  DenseTail tail;
+  tail.copy(L.data(), w);
+  ASSERT_EQ(tail.paddedWidth(), 24);
+  for (int columns = 1; columns <= 3; ++columns) {
+    SCOPED_TRACE(columns);
+    const Eigen::MatrixXd B = Eigen::MatrixXd::Random(w, columns);
+    Eigen::MatrixXd Y = Eigen::MatrixXd::Zero(tail.paddedWidth(), columns);
+    Y.topRows(w) = B;
+    tail.forward(Y.data(), columns);
+    const Eigen::MatrixXd forward = L.triangularView<Eigen::Lower>().solve(B);
+    EXPECT_LE((Y.topRows(w) - forward).cwiseAbs().maxCoeff(),
+              1e-12 * forward.cwiseAbs().maxCoeff());
+    EXPECT_EQ(Y.bottomRows(3).cwiseAbs().maxCoeff(), 0.0);  // the padding stays zero
+    Y.topRows(w) = B;
+    tail.backward(Y.data(), columns);
+    const Eigen::MatrixXd backward = L.transpose().triangularView<Eigen::Upper>().solve(B);
+    EXPECT_LE((Y.topRows(w) - backward).cwiseAbs().maxCoeff(),
+              1e-12 * backward.cwiseAbs().maxCoeff());
+  }
+}
+
 TEST(PrefactoredCholesky, SinglePrecisionFactorsSolveDiagonalChangesThroughACorrection) {
   const Model model(resampleCube(test::loadWorld("jello.w"), 6));
   const int n = model.numPoints();
