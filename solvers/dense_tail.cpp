@@ -73,23 +73,19 @@ void backwardPanels(const DenseTail::Data& f, int width, double* y0) {
   for (int c = 0; c < C; ++c) y[c] = y0 + static_cast<long>(c) * width;
   for (int p = width - kPanel; p >= 0; p -= kPanel) {
     // The panel's entries minus L's rows below it (by rows: the panel's eight columns to a
-    // vector) times their solved values, two rows at a time into two sums each.
-    Lanes even[C] = {}, odd[C] = {};
+    // vector) times their solved values, four rows at a time into four sums each (the
+    // additions of one sum wait for each other). The rows below come in whole panels.
+    Lanes sum[4][C] = {};
     const double* l = f.byRow + p;
-    int r = p + kPanel;
-    for (; r + 1 < width; r += 2) {
-      const Lanes l0 = load(l + static_cast<long>(r) * width);
-      const Lanes l1 = load(l + static_cast<long>(r + 1) * width);
-      for (int c = 0; c < C; ++c) {
-        even[c] += l0 * y[c][r];
-        odd[c] += l1 * y[c][r + 1];
+    for (int r = p + kPanel; r < width; r += 4) {
+      for (int u = 0; u < 4; ++u) {
+        const Lanes lu = load(l + static_cast<long>(r + u) * width);
+        for (int c = 0; c < C; ++c) sum[u][c] += lu * y[c][r + u];
       }
     }
-    for (; r < width; ++r) {
-      const Lanes l0 = load(l + static_cast<long>(r) * width);
-      for (int c = 0; c < C; ++c) even[c] += l0 * y[c][r];
+    for (int c = 0; c < C; ++c) {
+      store(y[c] + p, load(y[c] + p) - ((sum[0][c] + sum[1][c]) + (sum[2][c] + sum[3][c])));
     }
-    for (int c = 0; c < C; ++c) store(y[c] + p, load(y[c] + p) - (even[c] + odd[c]));
     multiplyPanel<C>(f.inverseTransposed + static_cast<long>(p) * kPanel, y, p);
   }
 }
