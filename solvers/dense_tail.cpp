@@ -93,7 +93,6 @@ void backwardPanels(const DenseTail::Data& f, int width, double* y0) {
 }  // namespace
 
 void DenseTail::copy(const double* block, int width) {
-  width_ = width;
   const int wp = paddedWidth_ = (width + kPanel - 1) / kPanel * kPanel;
   const auto size = static_cast<std::size_t>(wp) * static_cast<std::size_t>(wp);
   Data& f = data_;

@@ -1,10 +1,11 @@
-// The last supernode of a small Cholesky factor (PrefactoredCholesky's copied factors), solved as
-// a dense triangle: at 8^3, projective's M/h^2 + L ends in a dense block of 197 columns holding
-// 40% of L's entries, which the sparse copy reads one entry, one index and one gathered value at
-// a time. Here the block is read eight rows (or columns) to a vector for up to three right-hand
-// sides at once, in panels of eight columns whose 8 x 8 diagonal blocks are kept inverted (their
-// substitution becomes a product: no chain of dependent divisions). The right-hand sides are
-// given side by side, `paddedWidth()` entries each, the padding zero.
+// The last supernodes of a small Cholesky factor (PrefactoredCholesky's copied factors), solved as
+// one dense triangle: at 8^3, projective's M/h^2 + L ends in nearly dense columns (the last
+// supernode alone has 197 columns and 40% of L's entries), which the sparse copy reads one
+// entry, one index and one gathered value at a time. Here the triangle is read eight rows (or
+// columns) to a vector for up to three right-hand sides at once, in panels of eight columns whose
+// 8 x 8 diagonal blocks are kept inverted (their substitution becomes a product: no chain of
+// dependent divisions). The right-hand sides are given side by side, `paddedWidth()` entries
+// each, the padding zero.
 #pragma once
 
 #include <vector>
@@ -16,21 +17,21 @@ namespace jello {
 class DenseTail {
  public:
   static constexpr int kPanel = 8;
-  // block: the supernode's w x w lower triangle by columns (CHOLMOD's layout, diagonal
-  // included, the part above it ignored).
+  // block: the tail's width x width lower triangle by columns (as CHOLMOD lays out a
+  // supernode: diagonal included, the part above it ignored).
   void copy(const double* block, int width);
   // The tail of the numeric supernodal factor L (real, double) of an n x n matrix: its last
   // supernodes, as many as pay (kTailEntryCost in dense_tail.cpp), copied as one triangle when
   // they span at least two panels. Returns the tail's first column; n (and no tail) when none.
   int copyTail(const cholmod_factor_struct& L, int n);
-  void clear() { width_ = paddedWidth_ = 0; }
-  int width() const { return width_; }
+  void clear() { paddedWidth_ = 0; }
   int paddedWidth() const { return paddedWidth_; }
   // Solve L y = y (forward) and L' y = y (backward) in place, y holding `columns` (1 to 3)
   // right-hand sides of paddedWidth() entries one after the other.
   void forward(double* y, int columns) const;
   void backward(double* y, int columns) const;
-  // Room for three right-hand sides, aligned as the copy is (zero after copy()).
+  // Room for three right-hand sides of paddedWidth(), aligned as the copy is (the caller fills
+  // it, padding included).
   double* workspace() { return data_.work; }
 
   // The copy, as the kernels read it (public for them; not an interface). Every array starts
@@ -48,7 +49,7 @@ class DenseTail {
 
  private:
   Data data_;
-  int width_ = 0, paddedWidth_ = 0;
+  int paddedWidth_ = 0;
 };
 
 }  // namespace jello
