@@ -43,17 +43,6 @@ StateScan scanPoints(const State& s, std::ptrdiff_t lo, std::ptrdiff_t hi) {
 }
 
 std::optional<std::string> describeDivergence(const StateScan& scan, double bound,
-                                              double speedBound);
-
-}  // namespace
-
-std::optional<std::string> findDivergence(const State& s, double bound, double speedBound) {
-  return describeDivergence(scanPoints(s, 0, s.x.size() / 3), bound, speedBound);
-}
-
-namespace {
-
-std::optional<std::string> describeDivergence(const StateScan& scan, double bound,
                                               double speedBound) {
   if (!std::isfinite(scan.sum)) return std::string("a position or velocity is not finite");
   if (const double far = std::sqrt(scan.far2); far > bound) {
@@ -70,6 +59,10 @@ std::optional<std::string> describeDivergence(const StateScan& scan, double boun
 }
 
 }  // namespace
+
+std::optional<std::string> findDivergence(const State& s, double bound, double speedBound) {
+  return describeDivergence(scanPoints(s, 0, s.x.size() / 3), bound, speedBound);
+}
 
 double Simulation::energyBudget() const {
   return kEnergyGrowthFactor * energyEnvelope_ + kEnergyFloor;

@@ -71,9 +71,8 @@ void SystemOperator::gather(const SparseMatrix& A, const std::vector<int>& diagS
 void SystemOperator::apply(const double* p, double* y) const {
   // Split over threads as the spring forces are (src/parallel.h): every group's springs write
   // to their base points and partners at most maxDelta_ points further.
-  const int threads = n_ >= kParallelMinPoints ? parallelThreads() : 1;
   runOverPointBlocks(
-      splitPointBlocks(n_, maxDelta_, threads),
+      splitPointBlocks(n_, maxDelta_, threadsFor(n_)),
       [&](std::ptrdiff_t setLo, std::ptrdiff_t setHi, std::ptrdiff_t lo, std::ptrdiff_t hi) {
         applyRange(p, y, setLo, setHi, lo, hi);
       },

@@ -29,6 +29,11 @@ inline constexpr int kMaxParallelThreads = 64;
 int parallelThreads();
 // Sets it for the whole process (tests, benchmarks): 1 makes every loop serial.
 void setParallelThreads(int threads);
+// The threads a loop over `points` points is split over: parallelThreads() from
+// kParallelMinPoints up, else 1.
+inline int threadsFor(std::ptrdiff_t points) {
+  return points >= kParallelMinPoints ? parallelThreads() : 1;
+}
 // Unless JELLO_THREADS is set, splits loops over one CPU fewer than the process may run on (at
 // least one): for a program whose other thread is busy all the time, as the viewer's drawing is.
 // A loop's parts wait for each other, so a part whose CPU the other thread holds stalls them all:

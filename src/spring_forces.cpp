@@ -148,7 +148,7 @@ void SpringForces::accumulate(const double* x, const double* v, double* f) const
 }
 
 int SpringForces::threads() const {
-  return n_ >= kParallelMinPoints ? parallelThreads() : 1;
+  return threadsFor(n_);
 }
 
 void SpringForces::accumulateRange(const double* x, const double* v, double* f, std::ptrdiff_t lo,
@@ -196,10 +196,10 @@ void SpringForces::accumulateRange(const double* x, const double* v, double* f, 
 double SpringForces::energy(const double* x) const {
   const int threads = this->threads();
   if (threads <= 1) return energyRange(x, 0, 1);
-  // Both cores from 32^3 (the divergence check's energy is as long as a force evaluation): each
-  // part sums every group over its share of the base points; the parts' sums are then added in
-  // order (round-off apart from the serial sum). No allocation: the divergence check calls it
-  // step after step.
+  // Both cores from kParallelMinPoints (the divergence check's energy is as long as a force
+  // evaluation): each part sums every group over its share of the base points; the parts' sums are
+  // then added in order (round-off apart from the serial sum). No allocation: the divergence check
+  // calls it step after step.
   std::array<double, kMaxParallelThreads> parts{};
   runParallel(threads,
               [&](int t) { parts[static_cast<std::size_t>(t)] = energyRange(x, t, threads); });

@@ -313,7 +313,7 @@ TEST(SystemOperator, ThreadedProductEqualsTheSerialOne) {
       op.apply(p.data(), threaded.data());
       EXPECT_LT((threaded - expected).cwiseAbs().maxCoeff(), 1e-13 * scale);
       EXPECT_LT((threaded - serial).cwiseAbs().maxCoeff(), 1e-13 * scale);
-      if (n * n * n < SystemOperator::kParallelMinPoints) {
+      if (n * n * n < kParallelMinPoints) {
         EXPECT_EQ(threaded, serial);
       } else {
         EXPECT_NE(threaded, serial);  // split: some sums in another order
