@@ -1,8 +1,10 @@
 #include "solvers/projective_integrator.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "solvers/prefactored_cholesky.h"
 #include "solvers/spring_laplacian.h"
@@ -57,22 +59,42 @@ void ProjectiveIntegrator::bind(const Model& model) {
   factored_ = false;
 }
 
-void ProjectiveIntegrator::contactWeights(const Model& model, const double* x) {
-  const int n = n_;
-  for (auto& w : weights_) w.setZero();
-  if (const auto& walls = model.walls()) {
-    const double kc = walls->constants().stiffness;
-    for (int c = 0; c < 3; ++c)
-      for (int p = 0; p < n; ++p) {
-        if (std::abs(x[c * n + p]) > kBoxHalfSize) weights_[c][p] += kc;
-      }
+bool ProjectiveIntegrator::contactWeights(const Model& model, const double* x, std::ptrdiff_t lo,
+                                          std::ptrdiff_t hi) {
+  const std::ptrdiff_t n = n_;
+  const auto& walls = model.walls();
+  const double kc = walls ? walls->constants().stiffness : 0.0;
+  const bool solids = model.hasSolids();
+  // The largest difference from the factor's weights (both 0 or a contact's stiffness): a max,
+  // not a flag, so that the loops vectorize.
+  double differs = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    double* w = weights_[c].data();
+    const double* xc = x + c * n;
+    const double* factored = factoredWeights_[factorOf_[c]].data();
+    // The walls' weight where the coordinate is outside the box.
+#pragma omp simd reduction(max : differs)
+    for (std::ptrdiff_t p = lo; p < hi; ++p) {
+      const double wp = std::abs(xc[p]) > kBoxHalfSize ? kc : 0.0;
+      w[p] = wp;
+      differs = std::max(differs, std::abs(wp - factored[p]));
+    }
   }
-  if (!model.hasSolids()) return;
+  if (!solids) return differs > 0.0;
   const auto stiffness = [](const ContactConstants& k) { return k.stiffness; };
-  for (int p = 0; p < n; ++p) {
+  for (std::ptrdiff_t p = lo; p < hi; ++p) {
     const double w = model.solidContactWeight({x[p], x[n + p], x[2 * n + p]}, stiffness);
     for (int c = 0; c < 3; ++c) weights_[c][p] += w;
   }
+  differs = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    const double* w = weights_[c].data();
+    const double* factored = factoredWeights_[factorOf_[c]].data();
+#pragma omp simd reduction(max : differs)
+    for (std::ptrdiff_t p = lo; p < hi; ++p)
+      differs = std::max(differs, std::abs(w[p] - factored[p]));
+  }
+  return differs > 0.0;
 }
 
 StepResult ProjectiveIntegrator::factorChanged(double h) {
@@ -140,29 +162,43 @@ StepResult ProjectiveIntegrator::factorChanged(double h) {
 
 StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
   bind(model);
-  const int n = n_;
-  const double inertia = mass_ / (h * h);
-  y_ = s.x + h * s.v;
-  x_ = y_;
+  const std::ptrdiff_t n = n_, size = 3 * n;
+  const double inertia = mass_ / (h * h), inverseH = 1.0 / h;
+  y_.resize(size);
+  x_.resize(size);
+  v_.resize(size);
+  f_.resize(size);
+  delta_.resize(n, 3);
+  double *x = x_.data(), *v = v_.data(), *d = delta_.data();
+  const double *x0 = s.x.data(), *y = y_.data(), *f = f_.data();
+  const double* v0 = s.v.data();
+  for (std::ptrdiff_t i = 0; i < size; ++i) {  // the inertial prediction y = x0 + h v0 first
+    x[i] = y_[i] = x0[i] + h * v0[i];
+    v[i] = (x[i] - x0[i]) * inverseH;
+  }
   int iterations = 0;
   chebyshev_.start();  // ProjectiveOptions::chebyshevRho
   for (; iterations < options_.iterations; ++iterations) {
     if (interruptRequested()) return StepResult::interruption();  // s is still the start
-    // Local step inside the force evaluation; damping, field and user force at the iterate.
-    v_ = (x_ - s.x) / h;
-    model.forces(x_, v_, f_);
-    r_ = inertia * (x_ - y_) - f_;
-    contactWeights(model, x_.data());
-    bool changed = false;  // a coordinate's weights differ from those of the factor it uses
-    for (int c = 0; c < 3; ++c) changed = changed || weights_[c] != factoredWeights_[factorOf_[c]];
-    changed = changed && factored_ && h == h_;
+    // Local step inside the force evaluation (damping, field and user force at the iterate,
+    // v = (x - x0)/h); on each block of points once its forces are final, the global step's
+    // right-hand side -r = f - M (x - y)/h^2 and the contact weights at x, in the same pass.
+    std::atomic<bool> weightsDiffer{false};  // from those of the factor a coordinate uses
+    model.forces(x, v, f_.data(), [&](std::ptrdiff_t lo, std::ptrdiff_t hi) {
+      for (std::ptrdiff_t c = 0; c < 3; ++c) {
+        for (std::ptrdiff_t i = c * n + lo; i < c * n + hi; ++i) {
+          d[i] = f[i] - inertia * (x[i] - y[i]);
+        }
+      }
+      if (contactWeights(model, x, lo, hi)) weightsDiffer.store(true, std::memory_order_relaxed);
+    });
+    const bool changed = weightsDiffer.load(std::memory_order_relaxed) && factored_ && h == h_;
     if (changed) ++contactChanges_;
     if (!factored_ || h != h_ || changed) {
       if (StepResult res = factorChanged(h); !res.ok) return res;
     }
     // Global step: A_c delta_c = -r_c, the coordinates that share a factor solved together.
     const auto start = Clock::now();
-    delta_ = -Eigen::Map<const Eigen::MatrixXd>(r_.data(), n, 3);  // column c: coordinate c
     StepResult solved = StepResult::success();
     for (int c = 0; c < 3 && solved.ok;) {  // neighbouring columns with one factor: one solve
       int columns = 1;
@@ -172,21 +208,30 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
     }
     if (!solved.ok) return solved;
     solveSeconds_ += secondsSince(start);
-    auto x = Eigen::Map<Eigen::MatrixXd>(x_.data(), n, 3);
     if (options_.chebyshevRho > 0.0) {
       // A new contact set is a new iteration matrix: the Chebyshev run starts again.
       const double omega = chebyshev_.next(delta_.norm(), changed);
       if (omega != 1.0) {
         // x_next = omega (x + delta - previous) + previous; delta becomes x_next - x.
+        const auto xs = Eigen::Map<const Eigen::MatrixXd>(x, n, 3);
         const auto prev = Eigen::Map<const Eigen::MatrixXd>(previous_.data(), n, 3);
-        delta_ = omega * (x + delta_ - prev) + prev - x;
+        delta_ = omega * (xs + delta_ - prev) + prev - xs;
       }
       previous_ = x_;
     }
-    x += delta_;
-    const double update = delta_.cwiseAbs().maxCoeff();
-    lastUpdate_ = update;
-    if (!std::isfinite(update)) return StepResult::failure("projective update is not finite");
+    // x += delta, the next iterate's velocity and the largest move, in one pass.
+    double update = 0.0;
+    int finite = 1;
+#pragma omp simd reduction(max : update) reduction(& : finite)
+    for (std::ptrdiff_t i = 0; i < size; ++i) {
+      const double xi = x[i] + d[i], move = std::abs(d[i]);
+      x[i] = xi;
+      v[i] = (xi - x0[i]) * inverseH;
+      update = std::max(update, move);
+      finite &= int(move <= std::numeric_limits<double>::max());  // false for NaN too
+    }
+    lastUpdate_ = finite ? update : std::numeric_limits<double>::quiet_NaN();
+    if (!finite) return StepResult::failure("projective update is not finite");
     if (update <= options_.tolerance) {
       ++iterations;
       break;
@@ -195,7 +240,7 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
   lastIterations_ = iterations;
   iterations_ += iterations;
   ++steps_;
-  s.v = (x_ - s.x) / h;
+  s.v = v_;  // (x - x0)/h of the final iterate
   s.x = x_;  // copied, not swapped: the state's storage stays put (Integrator::step)
   s.t += h;
   return StepResult::success();

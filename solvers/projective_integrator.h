@@ -59,8 +59,9 @@ class ProjectiveIntegrator final : public Integrator {
 
  private:
   void bind(const Model& model);
-  // The contact weights of every coordinate at positions x (3n).
-  void contactWeights(const Model& model, const double* x);
+  // The contact weights of every coordinate at positions x (3n) for the points [lo, hi); true
+  // when one differs from the weights of the factor its coordinate uses.
+  bool contactWeights(const Model& model, const double* x, std::ptrdiff_t lo, std::ptrdiff_t hi);
   StepResult factorChanged(double h);
 
   ProjectiveOptions options_;
@@ -76,8 +77,8 @@ class ProjectiveIntegrator final : public Integrator {
   struct Factors;                           // CHOLMOD's, one per distinct matrix
   std::unique_ptr<Factors> factors_;
   bool factored_ = false;
-  Eigen::VectorXd y_, x_, v_, f_, r_, previous_;  // previous_: the iterate before x_
-  Eigen::MatrixXd delta_;                         // n x 3, the update of each coordinate
+  Eigen::VectorXd y_, x_, v_, f_, previous_;  // previous_: the iterate before x_; v_: (x_ - x0)/h
+  Eigen::MatrixXd delta_;                     // n x 3, the update of each coordinate
   int lastIterations_ = 0;
   double lastUpdate_ = 0.0;
   std::vector<std::pair<int, double>> changes_;  // a coordinate's changed contact weights

@@ -47,6 +47,10 @@ void Model::forces(const double* x, const double* v, double* f) const {
   evaluate(x, v, f, 1.0, [](std::ptrdiff_t, std::ptrdiff_t) {});
 }
 
+void Model::forces(const double* x, const double* v, double* f, PointRangeRef then) const {
+  evaluate(x, v, f, 1.0, then);
+}
+
 bool Model::addPointForces(const double* x, const double* v, double* f, int lo, int hi) const {
   const int n = n_;
   const bool walls = walls_ && !WallContact::allInside(x, n, lo, hi);

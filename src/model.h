@@ -84,6 +84,9 @@ class Model {
   // little faster on two).
   // then() may write x and v at [lo, hi) (no longer read there), and nothing outside it.
   void acceleration(const double* x, const double* v, double* a, PointRangeRef then) const;
+  // The forces, then then(lo, hi) on the same ranges once f is final there (projective's
+  // residual and contact weights ride along).
+  void forces(const double* x, const double* v, double* f, PointRangeRef then) const;
   // The same on Eigen vectors; the output is resized.
   void forces(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& f) const;
   void acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& a) const;
