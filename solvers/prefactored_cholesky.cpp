@@ -17,14 +17,10 @@ namespace {
 // Three right-hand sides and a pad, one vector register (AVX) per point.
 using Lanes = double __attribute__((vector_size(32)));
 
-// The entries of one right-hand side (T = double) or of the first `columns` of three (T = four
-// lanes).
-inline double& lane(double& y, int) {
-  return y;
-}
-inline double& lane(Lanes& y, int c) {
-  return reinterpret_cast<double*>(&y)[c];
-}
+// Doubles from one point's entries to the next in the substitutions: one right-hand side
+// (T = double) uses the first, three the first three.
+constexpr int kStride = 4;
+static_assert(sizeof(Lanes) == kStride * sizeof(double));
 
 // Forward substitution L y = y by rows, then backward L^T z = y by columns, in place; T is one
 // double or four lanes. Each row's sum runs over four accumulators: the additions of one row
@@ -37,39 +33,45 @@ void substitute(int n, const std::vector<int>& rowStart, const std::vector<int>&
                 const std::vector<double>& rowValue, const std::vector<int>& colStart,
                 const std::vector<int>& colRow, const std::vector<double>& colValue,
                 const std::vector<double>& inverseDiagonal, int tailStart, const DenseTail& tail,
-                int columns, double* work, T* y) {
-  const auto sweep = [y](const int* index, const double* value, int begin, int end, T sum) {
+                int columns, double* work, double* yd) {
+  // Point i's entry (one double or four lanes) at yd + kStride i; the copy's indices are such
+  // offsets already (an index scaled by 8 bytes in the address: no shift per entry).
+  const auto y = [yd](int offset) -> T& { return *reinterpret_cast<T*>(yd + offset); };
+  const auto sweep = [&y](const int* index, const double* value, int begin, int end, T sum) {
     T s1 = sum - sum, s2 = s1, s3 = s1;  // zero, for both T
     int q = begin;
     for (; q + 4 <= end; q += 4) {
-      sum -= value[q] * y[index[q]];
-      s1 -= value[q + 1] * y[index[q + 1]];
-      s2 -= value[q + 2] * y[index[q + 2]];
-      s3 -= value[q + 3] * y[index[q + 3]];
+      sum -= value[q] * y(index[q]);
+      s1 -= value[q + 1] * y(index[q + 1]);
+      s2 -= value[q + 2] * y(index[q + 2]);
+      s3 -= value[q + 3] * y(index[q + 3]);
     }
-    for (; q < end; ++q) sum -= value[q] * y[index[q]];
+    for (; q < end; ++q) sum -= value[q] * y(index[q]);
     return (sum + s1) + (s2 + s3);
   };
   for (int i = 0; i < tailStart; ++i) {
-    y[i] = sweep(rowColumn.data(), rowValue.data(), rowStart[i], rowStart[i + 1], y[i]) *
-           inverseDiagonal[i];
+    T& yi = y(kStride * i);
+    yi = sweep(rowColumn.data(), rowValue.data(), rowStart[i], rowStart[i + 1], yi) *
+         inverseDiagonal[i];
   }
   if (tailStart < n) {
     for (int i = tailStart; i < n; ++i) {
-      y[i] = sweep(rowColumn.data(), rowValue.data(), rowStart[i], rowStart[i + 1], y[i]);
+      T& yi = y(kStride * i);
+      yi = sweep(rowColumn.data(), rowValue.data(), rowStart[i], rowStart[i + 1], yi);
     }
     const int width = tail.paddedWidth();
     std::fill_n(work, static_cast<long>(columns) * width, 0.0);
     for (int i = tailStart; i < n; ++i)
-      for (int c = 0; c < columns; ++c) work[c * width + i - tailStart] = lane(y[i], c);
+      for (int c = 0; c < columns; ++c) work[c * width + i - tailStart] = yd[kStride * i + c];
     tail.forward(work, columns);
     tail.backward(work, columns);
     for (int i = tailStart; i < n; ++i)
-      for (int c = 0; c < columns; ++c) lane(y[i], c) = work[c * width + i - tailStart];
+      for (int c = 0; c < columns; ++c) yd[kStride * i + c] = work[c * width + i - tailStart];
   }
   for (int j = tailStart - 1; j >= 0; --j) {
-    y[j] = sweep(colRow.data(), colValue.data(), colStart[j], colStart[j + 1], y[j]) *
-           inverseDiagonal[j];
+    T& yj = y(kStride * j);
+    yj = sweep(colRow.data(), colValue.data(), colStart[j], colStart[j + 1], yj) *
+         inverseDiagonal[j];
   }
 }
 
@@ -95,7 +97,6 @@ struct PrefactoredCholesky::Impl {
   DiagonalCorrection correction;  // the diagonal's changes on top of the single-precision factor
   std::vector<int> inversePerm;
   std::vector<Lanes> lanes;
-  std::vector<double> single;
   DenseTail tail;                     // the copy's last supernodes, when it pays (dense_tail.h)
   std::vector<double> tailBlock;      // its triangle from an updated factor, by columns
   int defaultOrderings[3] = {};       // cholmod_start's, restored for small matrices
@@ -279,8 +280,10 @@ void PrefactoredCholesky::transposeCopy() {
       rowValue_[at] = colValue_[q];
     }
   }
+  // As the substitutions read them: offsets of the points' entries.
+  for (int& r : colRow_) r *= kStride;
+  for (int& j : rowColumn_) j *= kStride;
   impl_->lanes.resize(static_cast<std::size_t>(n));
-  impl_->single.resize(static_cast<std::size_t>(n));
 }
 
 StepResult PrefactoredCholesky::addToDiagonal(const std::vector<std::pair<int, double>>& changes) {
@@ -418,11 +421,11 @@ StepResult PrefactoredCholesky::solveFactored(double* b, int columns) const {
   }
   if (!s.copied) return solveByCholmod(b, columns);
   if (columns == 1) {
-    double* y = s.single.data();
-    for (int k = 0; k < n; ++k) y[k] = b[perm_[k]];
-    substitute(n, rowStart_, rowColumn_, rowValue_, colStart_, colRow_, colValue_, inverseDiagonal_,
-               tailStart_, s.tail, 1, s.tail.workspace(), y);
-    for (int k = 0; k < n; ++k) b[perm_[k]] = y[k];
+    auto* y = reinterpret_cast<double*>(s.lanes.data());
+    for (int k = 0; k < n; ++k) y[kStride * k] = b[perm_[k]];
+    substitute<double>(n, rowStart_, rowColumn_, rowValue_, colStart_, colRow_, colValue_,
+                       inverseDiagonal_, tailStart_, s.tail, 1, s.tail.workspace(), y);
+    for (int k = 0; k < n; ++k) b[perm_[k]] = y[kStride * k];
     return StepResult::success();
   }
   Lanes* y = s.lanes.data();
@@ -430,8 +433,9 @@ StepResult PrefactoredCholesky::solveFactored(double* b, int columns) const {
     const int p = perm_[k];
     y[k] = Lanes{b[p], columns > 1 ? b[n + p] : 0.0, columns > 2 ? b[2 * n + p] : 0.0, 0.0};
   }
-  substitute(n, rowStart_, rowColumn_, rowValue_, colStart_, colRow_, colValue_, inverseDiagonal_,
-             tailStart_, s.tail, columns, s.tail.workspace(), y);
+  substitute<Lanes>(n, rowStart_, rowColumn_, rowValue_, colStart_, colRow_, colValue_,
+                    inverseDiagonal_, tailStart_, s.tail, columns, s.tail.workspace(),
+                    reinterpret_cast<double*>(y));
   for (int k = 0; k < n; ++k) {
     const int p = perm_[k];
     b[p] = y[k][0];
