@@ -84,9 +84,11 @@ class PrefactoredCholesky {
   std::vector<int> perm_;  // row k of the factor is point perm_[k]
   int tailStart_ = 0;      // the copy's columns from here on are the dense tail's
   std::vector<double> inverseDiagonal_;
-  std::vector<int> rowStart_, rowColumn_;  // strictly lower L by rows
+  // Strictly lower L by rows and by columns (the points' indices in rowColumn_ and colRow_ are
+  // 4 x the point: offsets of their entries in the substitutions' workspace).
+  std::vector<int> rowStart_, rowColumn_;
   std::vector<double> rowValue_;
-  std::vector<int> colStart_, colRow_;  // strictly lower L by columns
+  std::vector<int> colStart_, colRow_;
   std::vector<double> colValue_;
 };
 
