@@ -21,6 +21,7 @@
 #include "experiments/studies/csv_table.h"
 #include "experiments/studies/parallel_for.h"
 #include "experiments/studies/ranks.h"
+#include "experiments/studies/run_context.h"
 #include "experiments/studies/stability_analysis.h"
 #include "solvers/jacobian.h"
 #include "solvers/simulation.h"
@@ -323,6 +324,35 @@ TEST(ScalingQuick, TheFreeSceneTouchesNothingAndMidpointKeepsItsMotionAtTheLarge
   EXPECT_GT(number(point["projective@100000"], "dt_s"), 20.0 * number(point["rk4@100000"], "dt_s"));
   EXPECT_LT(number(point["projective@100000"], "wall_per_simulated_s"),
             number(point["rk4@100000"], "wall_per_simulated_s"));
+}
+
+// --- the sidecar's record of the tree ------------------------------------------------------
+
+// A tracked file changed outside experiments/results/ marks the tree modified; the results an
+// earlier program of the same run wrote do not (they are not the code that runs).
+TEST(RunContext, ResultsWrittenByAnEarlierProgramDoNotMarkTheTreeModified) {
+  if (test::run("git --version").code != 0) GTEST_SKIP() << "no git";
+  test::TempDir dir;
+  const auto& root = dir.path();
+  std::filesystem::create_directories(root / "experiments" / "results");
+  std::filesystem::create_directories(root / "src");
+  const auto write = [](const std::filesystem::path& p, const std::string& text) {
+    std::ofstream(p) << text;
+  };
+  write(root / "src" / "code.cpp", "int x;\n");
+  write(root / "experiments" / "results" / "r.csv", "a\n1\n");
+  const std::string git = "git -C '" + root.string() + "' ";
+  ASSERT_EQ(test::run(git + "init -q && " + git + "add -A && " + git +
+                      "-c user.name=t -c user.email=t@t commit -q -m start")
+                .code,
+            0);
+  EXPECT_FALSE(treeModified(root));
+  write(root / "experiments" / "results" / "r.csv", "a\n2\n");
+  write(root / "experiments" / "results" / "new.csv", "a\n");  // untracked: ignored too
+  EXPECT_FALSE(treeModified(root));
+  write(root / "src" / "code.cpp", "int y;\n");
+  EXPECT_TRUE(treeModified(root));
+  EXPECT_FALSE(treeModified(root / "no-such-dir"));
 }
 
 // --- row order, threads and MPI ranks --------------------------------------------------------

@@ -64,11 +64,18 @@ double forceEvaluationSeconds() {
 
 }  // namespace
 
+bool treeModified(const std::filesystem::path& sourceDir) {
+  return !command("git -C '" + sourceDir.string() +
+                  "' status --porcelain --untracked-files=no -- . ':(exclude)experiments/results' "
+                  "2>/dev/null")
+              .empty();
+}
+
 nlohmann::json runContext(int argc, char** argv) {
   std::vector<std::string> args(argv, argv + argc);
   const std::string git = std::string("git -C '") + JELLO_SOURCE_DIR + "' ";
   const std::string commit = command(git + "rev-parse HEAD 2>/dev/null");
-  const bool dirty = !command(git + "status --porcelain --untracked-files=no 2>/dev/null").empty();
+  const bool dirty = treeModified(JELLO_SOURCE_DIR);
   utsname u{};
   const bool named = ::uname(&u) == 0;
   const std::time_t now = std::time(nullptr);

@@ -16,6 +16,11 @@ namespace jello::experiments {
 // Command line, commit and whether the tracked tree is modified, compiler, BLAS, machine, date:
 // taken as the run starts, so that the outputs the run writes do not mark its own tree modified.
 nlohmann::json runContext(int argc, char** argv);
+// Whether the git work tree at `sourceDir` has tracked changes outside experiments/results/: the
+// results an earlier program of the same run wrote there are not the code that runs (without
+// the exclusion, the second program of scripts/run-experiments.sh recorded a modified tree).
+// False when `sourceDir` is not a git work tree.
+bool treeModified(const std::filesystem::path& sourceDir);
 void writeSidecar(const std::filesystem::path& path, const nlohmann::json& sidecar);
 
 // Creates `dir` and checks that NAME.csv can be written there, before a long run: false, with
