@@ -142,6 +142,13 @@ void DenseTail::copy(const double* block, int width) {
   }
 }
 
+long supernodeEntries(const cholmod_factor& L, std::size_t sn) {
+  const auto* super = static_cast<const int*>(L.super);
+  const auto* pi = static_cast<const int*>(L.pi);
+  const long width = super[sn + 1] - super[sn], height = pi[sn + 1] - pi[sn];
+  return width * height - width * (width - 1) / 2;
+}
+
 int DenseTail::copyTail(const cholmod_factor& L, int n) {
   clear();
   const auto* super = static_cast<const int*>(L.super);
@@ -149,17 +156,13 @@ int DenseTail::copyTail(const cholmod_factor& L, int n) {
   const auto* px = static_cast<const int*>(L.px);
   const auto* rows = static_cast<const int*>(L.s);
   const auto* values = static_cast<const double*>(L.x);
-  const auto entries = [&](std::size_t sn) {  // stored in supernode sn, the diagonal's included
-    const long width = super[sn + 1] - super[sn], height = pi[sn + 1] - pi[sn];
-    return width * height - width * (width - 1) / 2;
-  };
   const auto triangle = [n, super](std::size_t sn) {  // entries of a tail from supernode sn
     const long width = n - super[sn];
     return width * (width + 1) / 2;
   };
   std::size_t first = L.nsuper - 1;  // the tail's first supernode
   while (first > 0 && kTailEntryCost * double(triangle(first - 1) - triangle(first)) <
-                          double(entries(first - 1))) {
+                          double(supernodeEntries(L, first - 1))) {
     --first;
   }
   const int start = super[first], width = n - start;

@@ -8,11 +8,16 @@
 // each, the padding zero.
 #pragma once
 
+#include <cstddef>
 #include <vector>
 
 struct cholmod_factor_struct;  // CHOLMOD's cholmod_factor
 
 namespace jello {
+
+// The entries CHOLMOD stores for supernode sn of a supernodal factor L (its lower trapezoid,
+// the diagonal included).
+long supernodeEntries(const cholmod_factor_struct& L, std::size_t sn);
 
 class DenseTail {
  public:

@@ -219,10 +219,7 @@ StepResult PrefactoredCholesky::factorize(const SparseMatrix& A,
   const auto* px = static_cast<const int*>(L->px);
   const auto* values = static_cast<const double*>(L->x);
   nonZeros_ = 0;
-  for (std::size_t sn = 0; sn < L->nsuper; ++sn) {
-    const long width = super[sn + 1] - super[sn], height = pi[sn + 1] - pi[sn];
-    nonZeros_ += width * height - width * (width - 1) / 2;
-  }
+  for (std::size_t sn = 0; sn < L->nsuper; ++sn) nonZeros_ += supernodeEntries(*L, sn);
   s.copied = nonZeros_ <= copyLimit_;
   s.singleCopy = !s.copied && singlePrecision_;
   n_ = n;

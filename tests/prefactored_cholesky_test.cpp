@@ -152,10 +152,6 @@ TEST_P(PrefactoredCholeskyBothWays, UpdatesAndDowndatesTheDiagonal) {
   EXPECT_LT((Eigen::MatrixXd(A) * X - B).norm(), 10 * tolerance() * B.norm() * dense.norm());
 }
 
-// The single-precision factor takes diagonal changes as a low-rank correction solved through
-// it (solvers/diagonal_correction.h): as close to a factorization of the changed matrix as the
-// factor itself is to the original, over rounds that add points, change them again and take
-// some back out (the correction then shrinks), and cleared by the next factorization.
 // The dense tail (solvers/dense_tail.h) on its own: a lower triangle of 21 columns (two whole
 // panels and a padded one) solves L y = b and L' y = b like Eigen's triangular solves, one to
 // three right-hand sides at once.
@@ -184,6 +180,10 @@ TEST(DenseTail, SolvesBothTrianglesLikeEigen) {
   }
 }
 
+// The single-precision factor takes diagonal changes as a low-rank correction solved through
+// it (solvers/diagonal_correction.h): as close to a factorization of the changed matrix as the
+// factor itself is to the original, over rounds that add points, change them again and take
+// some back out (the correction then shrinks), and cleared by the next factorization.
 TEST(PrefactoredCholesky, SinglePrecisionFactorsSolveDiagonalChangesThroughACorrection) {
   const Model model(resampleCube(test::loadWorld("jello.w"), 6));
   const int n = model.numPoints();
