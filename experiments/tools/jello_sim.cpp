@@ -218,7 +218,9 @@ int run(const Options& opt) {
     if (st.name == "newton_unconverged_steps" && st.value > 0) {
       std::fprintf(stderr,
                    "jello-sim: warning: %.0f of %ld steps did not converge within %d Newton "
-                   "iterations (raise --newton-iters or --newton-tol)\n",
+                   "iterations (raise --newton-iters or --newton-tol; but where a point meets a "
+                   "wall or an obstacle at speed the contact's damping force jumps and the "
+                   "step's equations may have no root: README, \"implicit\")\n",
                    st.value, done, opt.solver.implicit.newtonMaxIterations);
     }
   }
