@@ -282,22 +282,38 @@ ATLAS_FREE = "atlas_free"
 
 @functools.lru_cache(maxsize=None)
 def atlas_sources(subdirectory=""):
-    """Every committed atlas of a scene: (rows, sidecar) of scaling_atlas.csv (jello-scaling's
+    """Every committed atlas of a scene: (rows, sidecars) of scaling_atlas.csv (jello-scaling's
     full run) and of each NAME_atlas.csv an atlas-only run wrote (NAME.json its sidecar), by N,
-    from experiments/results (the falling scene) or a subdirectory of it (ATLAS_FREE); an N in
-    two files is an error. Read once (several blocks use it); not to be modified."""
+    from experiments/results (the falling scene) or a subdirectory of it (ATLAS_FREE). One N may
+    come from several runs over different k (N = 32's stiffest point was run apart): its
+    sidecars in file order; a (k, N) in two files is an error. Read once (several blocks use
+    it); not to be modified."""
     directory = os.path.join(RESULTS, subdirectory)
     names = sorted(f[:-len("_atlas.csv")] for f in os.listdir(directory)
                    if f.endswith("_atlas.csv"))
     by_n = {}
     for name in names:
         sidecar = read_sidecar(os.path.join(subdirectory, name))
-        for r in read_rows(os.path.join(subdirectory, name + "_atlas")):
-            n = int(r["n"])
-            if n in by_n and by_n[n][1] is not sidecar:
-                raise SystemExit(f"results-tables: the atlas at N = {n} is in two files")
-            by_n.setdefault(n, ([], sidecar))[0].append(r)
+        rows = read_rows(os.path.join(subdirectory, name + "_atlas"))
+        for n in sorted({int(r["n"]) for r in rows}):
+            mine = [r for r in rows if int(r["n"]) == n]
+            have, sidecars = by_n.setdefault(n, ([], []))
+            twice = {r["k_N_per_m"] for r in have} & {r["k_N_per_m"] for r in mine}
+            if twice:
+                raise SystemExit(f"results-tables: the atlas at N = {n}, k = "
+                                 f"{', '.join(sorted(twice))} is in two files")
+            have.extend(mine)
+            sidecars.append(sidecar)
     return by_n
+
+
+def atlas_run_text(sidecar, ks):
+    """Commit, date and run time of one atlas run, with its k when an N has several runs."""
+    return (f"commit {sidecar['commit'][:7]}"
+            f"{' (modified tree)' if sidecar.get('tree_modified') else ''}, "
+            f"{sidecar['date_utc'][:10]}, {sidecar['wall_time_s'] / 60:.0f} min"
+            f"{' with the resolution grid' if sidecar['parameters']['n'] else ''}"
+            + (f" for k = {', '.join(k_text(k) for k in ks)}" if ks else ""))
 
 
 ATLAS_EXPLICIT = {"euler", "symplectic", "rk4"}
@@ -313,20 +329,21 @@ def atlas_cheapest(rows, explicit=None):
 
 def atlas_summary(subdirectory=""):
     by_n = atlas_sources(subdirectory)
-    first = next(iter(by_n.values()))[1]["parameters"]["atlas"]
+    first = next(iter(by_n.values()))[1][0]["parameters"]["atlas"]
     checks = [float(r["reference_check_m"]) for rows, _ in by_n.values() for r in rows]
     lines = [f"Visible motion within {100 * first['tolerance_m']:g} cm at the corners over "
              f"{first['time_s']:g} s; the references within {1e3 * min(checks):.2g}-"
              f"{1e3 * max(checks):.2g} mm of RK4 at twice their step.", ""]
     pays = []
     for n in sorted(by_n):
-        rows, sidecar = by_n[n]
-        atlas = sidecar["parameters"]["atlas"]
+        rows, sidecars = by_n[n]
+        budgets = sorted({s["parameters"]["atlas"]["run_budget_s"] for s in sidecars})
+        runs = "; ".join(atlas_run_text(
+            s, sorted({float(r["k_N_per_m"]) for r in rows if float(r["k_N_per_m"]) in
+                       s["parameters"]["atlas"]["k_N_per_m"]}) if len(sidecars) > 1 else None)
+            for s in sidecars)
         lines += [f"**N = {n}** (wall time per simulated second; dt of the run in brackets; "
-                  f"budget {atlas['run_budget_s']:g} s a run; commit {sidecar['commit'][:7]}"
-                  f"{' (modified tree)' if sidecar.get('tree_modified') else ''}, "
-                  f"{sidecar['date_utc'][:10]}, {sidecar['wall_time_s'] / 60:.0f} min"
-                  f"{' with the resolution grid' if sidecar['parameters']['n'] else ''})", "",
+                  f"budget {' and '.join(f'{b:g}' for b in budgets)} s a run; {runs})", "",
                   "| k (N/m) | w_max (rad/s) | cheapest explicit | cheapest other | "
                   "other vs explicit | not reached or over budget |",
                   "|---|---|---|---|---|---|"]
@@ -378,7 +395,7 @@ def atlas_region():
             if not here:
                 cells.append("not run")
             elif best is None:
-                budget = by_n[n][1]["parameters"]["atlas"]["run_budget_s"]
+                budget = by_n[n][1][0]["parameters"]["atlas"]["run_budget_s"]
                 cells.append(f"none within {budget:g} s")
             else:
                 cells.append(f"{best['integrator']} "
@@ -399,15 +416,23 @@ def experiments_runtime():
     text = (f"The committed results took {total / 60:.0f} minutes of wall time to make on 2-core "
             f"VMs ({each}; each sidecar's `wall_time_s`, machine and date).")
     # The atlas-only runs (scripts/run-experiments.sh atlas): one per N, side by side.
-    extra = sorted((int(rows[0]["n"]), sidecar["wall_time_s"])
-                   for rows, sidecar in atlas_sources().values()
-                   if not sidecar["parameters"]["n"])
+    # (N, k of the run when N has several, minutes)
+    extra = [(n, sidecar["parameters"]["atlas"]["k_N_per_m"] if len(sidecars) > 1 else None,
+              sidecar["wall_time_s"] / 60)
+             for n, (_, sidecars) in sorted(atlas_sources().items()) for sidecar in sidecars
+             if not sidecar["parameters"]["n"]]
     if extra:
-        text += (" The atlas at " + " and ".join(f"N = {n}" for n, _ in extra) + " took " +
-                 " and ".join(f"{t / 60:.0f} min" for _, t in extra) +
-                 ", each on one core of the same machine, side by side.")
-    free = sorted((int(rows[0]["n"]), sidecar["wall_time_s"], sidecar["parameters"]["jobs"])
-                  for rows, sidecar in atlas_sources(ATLAS_FREE).values())
+        def which(n, ks):
+            if not ks:
+                return f"N = {n}"
+            span = k_text(ks[0]) + ("" if len(ks) == 1 else f" to {k_text(ks[-1])}")
+            return f"N = {n} at k = {span}"
+        text += (" The atlas at " + " and ".join(which(n, ks) for n, ks, _ in extra) +
+                 " took " + " and ".join(f"{t:.0f} min" for _, _, t in extra) +
+                 ", each on one core of the same machine.")
+    free = sorted((n, sidecar["wall_time_s"], sidecar["parameters"]["jobs"])
+                  for n, (_, sidecars) in atlas_sources(ATLAS_FREE).items()
+                  for sidecar in sidecars)
     if free:
         text += (" The free scene's atlas at " + " and ".join(f"N = {n}" for n, _, _ in free) +
                  " took " + " and ".join(

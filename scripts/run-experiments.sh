@@ -4,8 +4,9 @@
 # from the sidecars). `scripts/run-experiments.sh quick`
 # runs the --quick grids instead (under a minute), into build/experiments-quick/.
 # `scripts/run-experiments.sh atlas` runs the crossover atlas at N = 16 (k = 1e2..1e8) and N = 32
-# (k = 1e2..1e6; above, its RK4 reference alone is hours) instead, side by side, one core each
-# (about an hour and a half on a 2-core VM), and redraws the atlas charts.
+# (k = 1e2..1e6, then 1e7 in a run of its own; at 1e8 its RK4 reference alone, 2.5 million steps
+# of 32^3, is hours) instead, side by side, one core each (about two hours on a 2-core VM), and
+# redraws the atlas charts.
 # `scripts/run-experiments.sh atlas-free` runs the atlas's second scene (the same throw and spin
 # without gravity: no contact) at N = 8 (one core), then at N = 16 for k = 1e5, 1e6, 1e7 (a 60 s
 # budget, two points at a time) into experiments/results/atlas_free/, and draws its charts
@@ -49,6 +50,8 @@ if [ "${1:-}" = atlas ]; then
   first=$!
   taskset -c 1 "$bin/jello-scaling" "${common[@]}" --atlas-n 32 \
     --atlas-k 1e2,1e3,1e4,1e5,1e6 --name atlas32 --quiet
+  taskset -c 1 "$bin/jello-scaling" "${common[@]}" --atlas-n 32 --atlas-k 1e7 \
+    --name atlas32stiff --quiet
   wait "$first"
   draw_atlas
   echo "run-experiments: the atlas at N = 16 and 32 in $out/"
