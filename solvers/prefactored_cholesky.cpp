@@ -10,6 +10,7 @@
 #include "solvers/dense_tail.h"
 #include "solvers/diagonal_correction.h"
 #include "solvers/single_supernodes.h"
+#include "src/assertions.h"
 
 namespace jello {
 namespace {
@@ -22,43 +23,102 @@ using Lanes = double __attribute__((vector_size(32)));
 constexpr int kStride = 4;
 static_assert(sizeof(Lanes) == kStride * sizeof(double));
 
-// Forward substitution L y = y by rows, then backward L^T z = y by columns, in place; T is one
-// double or four lanes. Each row's sum runs over four accumulators: the additions of one row
-// are independent, so the loop is bound by loads, not by the adder's latency. The rows and
-// columns from tailStart on are the dense tail's (its entries are not in the copy): their rows'
-// sums over the columns before it come first, then the tail's own forward and backward
-// substitutions over `work`, side by side, then the columns before it.
-template <typename T>
-void substitute(int n, const std::vector<int>& rowStart, const std::vector<int>& rowColumn,
-                const std::vector<double>& rowValue, const std::vector<int>& colStart,
-                const std::vector<int>& colRow, const std::vector<double>& colValue,
-                const std::vector<double>& inverseDiagonal, int tailStart, const DenseTail& tail,
-                int columns, double* work, double* yd) {
-  // Point i's entry (one double or four lanes) at yd + kStride i; the copy's indices are such
-  // offsets already (an index scaled by 8 bytes in the address: no shift per entry).
-  const auto y = [yd](int offset) -> T& { return *reinterpret_cast<T*>(yd + offset); };
-  const auto sweep = [&y](const int* index, const double* value, int begin, int end, T sum) {
-    T s1 = sum - sum, s2 = s1, s3 = s1;  // zero, for both T
-    int q = begin;
-    for (; q + 4 <= end; q += 4) {
-      sum -= value[q] * y(index[q]);
-      s1 -= value[q + 1] * y(index[q + 1]);
-      s2 -= value[q + 2] * y(index[q + 2]);
-      s3 -= value[q + 3] * y(index[q + 3]);
+// The copy's columns before the dense tail, by CHOLMOD's supernodes: a supernode's columns
+// share their rows below it, so its entries are stored as one dense block by rows (its own
+// triangle, then the rows below, explicit zeros included), and the substitutions hold eight of
+// its columns' values in registers while they run over the rows: an entry costs one load and
+// one multiply-add, where the copy by single entries cost an index, a gathered value and the
+// entry. At 8^3 the part before the tail is 32 supernodes over 249 columns.
+struct SupernodeBlocks {
+  std::vector<int> start;       // first column of each supernode; the last entry is the tail's
+  std::vector<int> rowStart;    // each supernode's rows in `rows`: its columns, then those below
+  std::vector<int> rows;        // offsets of the rows' entries (kStride x the row)
+  std::vector<int> valueStart;  // each supernode's block in `values`, rows x width by rows
+  std::vector<double> values;
+  std::vector<int> local;  // blockCopy's work: a row's place in a block
+};
+
+// One chunk of W <= 8 of a supernode's columns (values in `yc`, registers), and the block's
+// rows after the chunk's own: forward, the chunk's triangle, then y_r -= L_r,chunk yc for each
+// row; backward, yc -= sum over the rows of L_r,chunk' y_r, then the chunk's triangle
+// transposed. `v` is the chunk's first column in its first row, `stride` the block's width;
+// `diagonal` the chunk's inverse diagonal. T: one double or four lanes.
+template <typename T, int W>
+void forwardChunk(const int* rows, int count, const double* v, int stride, const double* diagonal,
+                  T* chunk, double* yd) {
+  T yc[W];
+  for (int k = 0; k < W; ++k) yc[k] = chunk[k];
+  for (int j = 0; j < W; ++j) {
+    yc[j] *= diagonal[j];
+    for (int k = j + 1; k < W; ++k) yc[k] -= v[k * stride + j] * yc[j];
+  }
+  for (int k = 0; k < W; ++k) chunk[k] = yc[k];
+  v += W * stride;
+  for (int q = 0; q < count; ++q, v += stride) {
+    T& yr = *reinterpret_cast<T*>(yd + rows[q]);
+    T sum = yr;
+    for (int k = 0; k < W; ++k) sum -= v[k] * yc[k];
+    yr = sum;
+  }
+}
+template <typename T, int W>
+void backwardChunk(const int* rows, int count, const double* v, int stride, const double* diagonal,
+                   T* chunk, const double* yd) {
+  T acc[W] = {};
+  const double* below = v + W * stride;
+  for (int q = 0; q < count; ++q, below += stride) {
+    const T yr = *reinterpret_cast<const T*>(yd + rows[q]);
+    for (int k = 0; k < W; ++k) acc[k] += below[k] * yr;
+  }
+  T yc[W];
+  for (int k = 0; k < W; ++k) yc[k] = chunk[k] - acc[k];
+  for (int j = W - 1; j >= 0; --j) {
+    yc[j] *= diagonal[j];
+    for (int k = 0; k < j; ++k) yc[k] -= v[j * stride + k] * yc[j];
+  }
+  for (int k = 0; k < W; ++k) chunk[k] = yc[k];
+}
+template <typename T, bool Forward, int W = 8>
+void chunk(int width, const int* rows, int count, const double* v, int stride,
+           const double* diagonal, T* values, double* yd) {
+  if constexpr (W > 1) {
+    if (width < W) {
+      return chunk<T, Forward, W - 1>(width, rows, count, v, stride, diagonal, values, yd);
     }
-    for (; q < end; ++q) sum -= value[q] * y(index[q]);
-    return (sum + s1) + (s2 + s3);
-  };
-  for (int i = 0; i < tailStart; ++i) {
-    T& yi = y(kStride * i);
-    yi = sweep(rowColumn.data(), rowValue.data(), rowStart[i], rowStart[i + 1], yi) *
-         inverseDiagonal[i];
+  }
+  if constexpr (Forward) {
+    forwardChunk<T, W>(rows, count, v, stride, diagonal, values, yd);
+  } else {
+    backwardChunk<T, W>(rows, count, v, stride, diagonal, values, yd);
+  }
+}
+
+// Forward substitution L y = y, then backward L^T z = y, in place, T one double or four lanes
+// (point i's entry at yd + kStride i): the supernodes before the tail, eight columns at a time,
+// push their solved values into the rows after them (the tail's rows included), the tail solves
+// both triangles over `work` (its rows side by side), and the supernodes, last first, pull the
+// solved values of the rows after them.
+template <typename T>
+void substitute(int n, const SupernodeBlocks& b, const std::vector<double>& inverseDiagonal,
+                int tailStart, const DenseTail& tail, int columns, double* work, double* yd) {
+  constexpr int kChunk = 8;
+  const auto at = [yd](int point) -> T& { return *reinterpret_cast<T*>(yd + kStride * point); };
+  const int supernodes = static_cast<int>(b.start.size()) - 1;
+  for (int sn = 0; sn < supernodes; ++sn) {
+    const int c0 = b.start[sn], width = b.start[sn + 1] - c0;
+    const int* rows = b.rows.data() + b.rowStart[sn];
+    const int height = b.rowStart[sn + 1] - b.rowStart[sn];
+    const double* v = b.values.data() + b.valueStart[sn];
+    for (int j = 0; j < width; j += kChunk) {
+      T values[kChunk];
+      const int w = std::min(kChunk, width - j);
+      for (int k = 0; k < w; ++k) values[k] = at(c0 + j + k);
+      chunk<T, true>(w, rows + j + w, height - j - w, v + static_cast<long>(j) * width + j, width,
+                     inverseDiagonal.data() + c0 + j, values, yd);
+      for (int k = 0; k < w; ++k) at(c0 + j + k) = values[k];
+    }
   }
   if (tailStart < n) {
-    for (int i = tailStart; i < n; ++i) {
-      T& yi = y(kStride * i);
-      yi = sweep(rowColumn.data(), rowValue.data(), rowStart[i], rowStart[i + 1], yi);
-    }
     const int width = tail.paddedWidth();
     std::fill_n(work, static_cast<long>(columns) * width, 0.0);
     for (int i = tailStart; i < n; ++i)
@@ -68,10 +128,19 @@ void substitute(int n, const std::vector<int>& rowStart, const std::vector<int>&
     for (int i = tailStart; i < n; ++i)
       for (int c = 0; c < columns; ++c) yd[kStride * i + c] = work[c * width + i - tailStart];
   }
-  for (int j = tailStart - 1; j >= 0; --j) {
-    T& yj = y(kStride * j);
-    yj = sweep(colRow.data(), colValue.data(), colStart[j], colStart[j + 1], yj) *
-         inverseDiagonal[j];
+  for (int sn = supernodes - 1; sn >= 0; --sn) {
+    const int c0 = b.start[sn], width = b.start[sn + 1] - c0;
+    const int* rows = b.rows.data() + b.rowStart[sn];
+    const int height = b.rowStart[sn + 1] - b.rowStart[sn];
+    const double* v = b.values.data() + b.valueStart[sn];
+    for (int j = (width - 1) / kChunk * kChunk; j >= 0; j -= kChunk) {
+      T values[kChunk];
+      const int w = std::min(kChunk, width - j);
+      for (int k = 0; k < w; ++k) values[k] = at(c0 + j + k);
+      chunk<T, false>(w, rows + j + w, height - j - w, v + static_cast<long>(j) * width + j, width,
+                      inverseDiagonal.data() + c0 + j, values, yd);
+      for (int k = 0; k < w; ++k) at(c0 + j + k) = values[k];
+    }
   }
 }
 
@@ -82,7 +151,11 @@ void substitute(int n, const std::vector<int>& rowStart, const std::vector<int>&
 // points (L of 48,000, 139,000, 340,000 and 1.1 million entries), the copy solved in 0.45, 0.65,
 // 0.8 and 1.6 times CHOLMOD's time (kDefaultCopyLimit); the single-precision supernodes
 // (BM_KeptFactorSolve, 2026-12-03): 38, 94 and 194 us at 8^3, 10^3 and 12^3 against the copy's
-// 33, 110 and 283.
+// 33, 110 and 283. The copy by supernode blocks then solved 10^3 and 12^3 in 61 and 136 us
+// (single precision 89 and 181), but jello.w's contact changes, which the copy takes as
+// cholmod_updown's updates copied again and the single-precision factor as a low-rank
+// correction, made a projective run at 10^3 and 12^3 1.6x and 2.2x slower with the copy: the
+// limit stays.
 constexpr int kOrderingsMinSize = 1000;
 
 struct PrefactoredCholesky::Impl {
@@ -97,6 +170,7 @@ struct PrefactoredCholesky::Impl {
   DiagonalCorrection correction;  // the diagonal's changes on top of the single-precision factor
   std::vector<int> inversePerm;
   std::vector<Lanes> lanes;
+  SupernodeBlocks blocks;             // the copy's supernodes before the tail
   DenseTail tail;                     // the copy's last supernodes, when it pays (dense_tail.h)
   std::vector<double> tailBlock;      // its triangle from an updated factor, by columns
   int defaultOrderings[3] = {};       // cholmod_start's, restored for small matrices
@@ -239,6 +313,11 @@ StepResult PrefactoredCholesky::factorize(const SparseMatrix& A,
   colRow_.clear();
   colValue_.clear();
   tailStart_ = s.tail.copyTail(*L, n);
+  s.blocks.start.clear();
+  for (std::size_t sn = 0; sn < L->nsuper && super[sn] < tailStart_; ++sn) {
+    s.blocks.start.push_back(super[sn]);
+  }
+  s.blocks.start.push_back(tailStart_);
   for (std::size_t sn = 0; sn < L->nsuper; ++sn) {
     const int first = super[sn], last = super[sn + 1];
     const int height = pi[sn + 1] - pi[sn];
@@ -258,29 +337,61 @@ StepResult PrefactoredCholesky::factorize(const SparseMatrix& A,
       colStart_[static_cast<std::size_t>(j) + 1] = static_cast<int>(colRow_.size());
     }
   }
-  transposeCopy();
+  blockCopy(false);
   return StepResult::success();
 }
 
-void PrefactoredCholesky::transposeCopy() {
-  const int n = n_;
-  rowStart_.assign(static_cast<std::size_t>(n) + 1, 0);
-  for (int r : colRow_) ++rowStart_[static_cast<std::size_t>(r) + 1];
-  for (int i = 0; i < n; ++i) rowStart_[i + 1] += rowStart_[i];
-  rowColumn_.resize(colRow_.size());
-  rowValue_.resize(colRow_.size());
-  std::vector<int> next(rowStart_.begin(), rowStart_.end() - 1);
-  for (int j = 0; j < n; ++j) {
-    for (int q = colStart_[j]; q < colStart_[j + 1]; ++q) {
-      const int at = next[static_cast<std::size_t>(colRow_[q])]++;
-      rowColumn_[at] = j;
-      rowValue_[at] = colValue_[q];
+void PrefactoredCholesky::blockCopy(bool samePattern) {
+  SupernodeBlocks& b = impl_->blocks;
+  const int supernodes = static_cast<int>(b.start.size()) - 1;
+  std::vector<int>& local = b.local;  // a row's place in the block being filled; -1: none
+  local.assign(static_cast<std::size_t>(n_), -1);
+  // The values into the blocks' pattern, supernode by supernode; false when an entry lies
+  // outside it (a new pattern).
+  const auto fill = [&] {
+    std::fill(b.values.begin(), b.values.end(), 0.0);
+    for (int sn = 0; sn < supernodes; ++sn) {
+      const int c0 = b.start[sn], c1 = b.start[sn + 1], width = c1 - c0;
+      const int first = b.rowStart[sn], height = b.rowStart[sn + 1] - first;
+      for (int q = 0; q < height; ++q) local[b.rows[first + q] / kStride] = q;
+      double* block = b.values.data() + b.valueStart[sn];
+      for (int j = c0; j < c1; ++j) {
+        for (int q = colStart_[j]; q < colStart_[j + 1]; ++q) {
+          const int row = local[static_cast<std::size_t>(colRow_[q])];
+          if (row < 0) return false;
+          block[static_cast<std::ptrdiff_t>(row) * width + (j - c0)] = colValue_[q];
+        }
+      }
+      for (int q = 0; q < height; ++q) local[b.rows[first + q] / kStride] = -1;
     }
+    return true;
+  };
+  if (samePattern && fill()) return;
+  // The pattern: each supernode's own columns, then every row of its columns' entries from c1
+  // on (CHOLMOD's supernodes share them; the copy dropped explicit zeros, so the union is
+  // taken).
+  std::fill(local.begin(), local.end(), -1);
+  b.rowStart.assign(1, 0);
+  b.rows.clear();
+  b.valueStart.assign(1, 0);
+  for (int sn = 0; sn < supernodes; ++sn) {
+    const int c0 = b.start[sn], c1 = b.start[sn + 1], width = c1 - c0;
+    const std::size_t first = b.rows.size();
+    for (int j = c0; j < c1; ++j) b.rows.push_back(j);
+    for (int j = c0; j < c1; ++j)
+      for (int q = colStart_[j]; q < colStart_[j + 1]; ++q)
+        if (colRow_[q] >= c1) b.rows.push_back(colRow_[q]);
+    const auto below = b.rows.begin() + static_cast<std::ptrdiff_t>(first) + width;
+    std::sort(below, b.rows.end());
+    b.rows.erase(std::unique(below, b.rows.end()), b.rows.end());
+    for (std::size_t q = first; q < b.rows.size(); ++q) b.rows[q] *= kStride;  // as read
+    b.rowStart.push_back(static_cast<int>(b.rows.size()));
+    b.valueStart.push_back(b.valueStart.back() + static_cast<int>(b.rows.size() - first) * width);
   }
-  // As the substitutions read them: offsets of the points' entries.
-  for (int& r : colRow_) r *= kStride;
-  for (int& j : rowColumn_) j *= kStride;
-  impl_->lanes.resize(static_cast<std::size_t>(n));
+  b.values.assign(static_cast<std::size_t>(b.valueStart.back()), 0.0);
+  const bool filled = fill();
+  JELLO_ASSERT(filled, "every entry lies in the blocks' pattern made from them");
+  impl_->lanes.resize(static_cast<std::size_t>(n_));
 }
 
 StepResult PrefactoredCholesky::addToDiagonal(const std::vector<std::pair<int, double>>& changes) {
@@ -387,7 +498,7 @@ StepResult PrefactoredCholesky::addToDiagonal(const std::vector<std::pair<int, d
     colStart_[static_cast<std::size_t>(j) + 1] = static_cast<int>(colRow_.size());
   }
   if (tail < n) s.tail.copy(s.tailBlock.data(), width);
-  transposeCopy();
+  blockCopy(true);  // same ordering and supernodes: the values into the blocks
   return StepResult::success();
 }
 
@@ -420,8 +531,7 @@ StepResult PrefactoredCholesky::solveFactored(double* b, int columns) const {
   if (columns == 1) {
     auto* y = reinterpret_cast<double*>(s.lanes.data());
     for (int k = 0; k < n; ++k) y[kStride * k] = b[perm_[k]];
-    substitute<double>(n, rowStart_, rowColumn_, rowValue_, colStart_, colRow_, colValue_,
-                       inverseDiagonal_, tailStart_, s.tail, 1, s.tail.workspace(), y);
+    substitute<double>(n, s.blocks, inverseDiagonal_, tailStart_, s.tail, 1, s.tail.workspace(), y);
     for (int k = 0; k < n; ++k) b[perm_[k]] = y[kStride * k];
     return StepResult::success();
   }
@@ -430,8 +540,7 @@ StepResult PrefactoredCholesky::solveFactored(double* b, int columns) const {
     const int p = perm_[k];
     y[k] = Lanes{b[p], columns > 1 ? b[n + p] : 0.0, columns > 2 ? b[2 * n + p] : 0.0, 0.0};
   }
-  substitute<Lanes>(n, rowStart_, rowColumn_, rowValue_, colStart_, colRow_, colValue_,
-                    inverseDiagonal_, tailStart_, s.tail, columns, s.tail.workspace(),
+  substitute<Lanes>(n, s.blocks, inverseDiagonal_, tailStart_, s.tail, columns, s.tail.workspace(),
                     reinterpret_cast<double*>(y));
   for (int k = 0; k < n; ++k) {
     const int p = perm_[k];

@@ -2,13 +2,15 @@
 // factor is kept for hundreds of solves (projective's M/h^2 + L, the projective preconditioner
 // of CG). CHOLMOD factors (supernodal, the best ordering of three); the solves then run over
 // a copy of the factor, in one of two forms by its size:
-// - up to copyLimit entries, L by rows and by columns in two plain arrays, the three
-//   right-hand sides side by side in one 4-wide vector per point and four independent
-//   accumulators per row, so every entry of L is read once per triangle for all three columns
-//   and no chain of dependent additions limits the loop; the factor's last supernodes (at 8^3
-//   263 of 512 columns, 61% of L) as one dense triangle (solvers/dense_tail.h), read eight
-//   entries to a vector. Measured at 8^3 (512 points, 48,000 entries in L, three columns): 20
-//   us, against 32 us for the copy without the tail and about 77 us for CHOLMOD's own solve.
+// - up to copyLimit entries, the supernodes before the tail as dense blocks by rows (explicit
+//   zeros included), the three right-hand sides side by side in one 4-wide vector per point;
+//   the substitutions hold eight of a supernode's columns in registers while they run over its
+//   rows, so an entry of L costs one load and one multiply-add for all three columns; the
+//   factor's last supernodes (at 8^3 263 of 512 columns, 61% of L) as one dense triangle
+//   (solvers/dense_tail.h), read eight entries to a vector. Measured at 8^3 (512 points,
+//   48,000 entries in L, three columns): 20 us, against 32 us for the copy without the tail
+//   and about 77 us for CHOLMOD's own solve (the blocks: 3-5% less than the copy by single
+//   entries at 8^3, 20% less at 10^3).
 // - above (10^3 points and more: the copy and its indices no longer stay in cache), CHOLMOD's
 //   dense supernodes copied in single precision and solved by our own blocked substitutions
 //   (solvers/single_supernodes.h),
@@ -78,16 +80,15 @@ class PrefactoredCholesky {
   bool singlePrecision_;
   StepResult solveFactored(double* b, int columns) const;  // the factor, without corrections
   StepResult solveByCholmod(double* b, int columns) const;
-  void transposeCopy();  // L by rows from L by columns
+  // The supernodes before the tail as dense blocks, from L by columns; samePattern: into the
+  // blocks of the last call when every entry falls in them (after an update).
+  void blockCopy(bool samePattern);
   int n_ = 0;
   long nonZeros_ = 0;
   std::vector<int> perm_;  // row k of the factor is point perm_[k]
   int tailStart_ = 0;      // the copy's columns from here on are the dense tail's
   std::vector<double> inverseDiagonal_;
-  // Strictly lower L by rows and by columns (the points' indices in rowColumn_ and colRow_ are
-  // 4 x the point: offsets of their entries in the substitutions' workspace).
-  std::vector<int> rowStart_, rowColumn_;
-  std::vector<double> rowValue_;
+  // Strictly lower L by columns, the columns before the tail (blockCopy's source).
   std::vector<int> colStart_, colRow_;
   std::vector<double> colValue_;
 };
