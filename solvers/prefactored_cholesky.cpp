@@ -38,11 +38,12 @@ struct SupernodeBlocks {
   std::vector<int> local;  // blockCopy's work: a row's place in a block
 };
 
-// One chunk of W <= 8 of a supernode's columns (values in `yc`, registers), and the block's
-// rows after the chunk's own: forward, the chunk's triangle, then y_r -= L_r,chunk yc for each
-// row; backward, yc -= sum over the rows of L_r,chunk' y_r, then the chunk's triangle
-// transposed. `v` is the chunk's first column in its first row, `stride` the block's width;
-// `diagonal` the chunk's inverse diagonal. T: one double or four lanes.
+// One chunk of W <= 8 of a supernode's columns, their values y_c in `chunk` (held in
+// registers meanwhile), and the block's rows after the chunk's own. Forward: the chunk's
+// triangle, then for each row r, y_r -= L_rc y_c. Backward: y_c -= (sum over the rows of
+// L_rc' y_r), then the chunk's triangle transposed. `v` is the chunk's first column in its
+// first row, `stride` the block's width, `diagonal` the chunk's inverse diagonal; T one double
+// or four lanes.
 template <typename T, int W>
 void forwardChunk(const int* rows, int count, const double* v, int stride, const double* diagonal,
                   T* chunk, double* yd) {
