@@ -415,8 +415,8 @@ def experiments_runtime():
                      for n, t, j in parts)
     text = (f"The committed results took {total / 60:.0f} minutes of wall time to make on 2-core "
             f"VMs ({each}; each sidecar's `wall_time_s`, machine and date).")
-    # The atlas-only runs (scripts/run-experiments.sh atlas): one per N, side by side.
-    # (N, k of the run when N has several, minutes)
+    # The atlas-only runs (scripts/run-experiments.sh atlas), one or more per N: (N, the run's
+    # k when N has several, minutes).
     extra = [(n, sidecar["parameters"]["atlas"]["k_N_per_m"] if len(sidecars) > 1 else None,
               sidecar["wall_time_s"] / 60)
              for n, (_, sidecars) in sorted(atlas_sources().items()) for sidecar in sidecars
