@@ -10,7 +10,7 @@
 #include "solvers/dense_tail.h"
 #include "solvers/diagonal_correction.h"
 #include "solvers/single_supernodes.h"
-#include "src/assertions.h"
+#include "solvers/supernode_blocks.h"
 
 namespace jello {
 namespace {
@@ -20,105 +20,17 @@ using Lanes = double __attribute__((vector_size(32)));
 
 // Doubles from one point's entries to the next in the substitutions: one right-hand side
 // (T = double) uses the first, three the first three.
-constexpr int kStride = 4;
+constexpr int kStride = kSubstitutionStride;
 static_assert(sizeof(Lanes) == kStride * sizeof(double));
 
-// The copy's columns before the dense tail, by CHOLMOD's supernodes: a supernode's columns
-// share their rows below it, so its entries are stored as one dense block by rows (its own
-// triangle, then the rows below, explicit zeros included), and the substitutions hold eight of
-// its columns' values in registers while they run over the rows: an entry costs one load and
-// one multiply-add, where the copy by single entries cost an index, a gathered value and the
-// entry. At 8^3 the part before the tail is 32 supernodes over 249 columns.
-struct SupernodeBlocks {
-  std::vector<int> start;       // first column of each supernode; the last entry is the tail's
-  std::vector<int> rowStart;    // each supernode's rows in `rows`: its columns, then those below
-  std::vector<int> rows;        // offsets of the rows' entries (kStride x the row)
-  std::vector<int> valueStart;  // each supernode's block in `values`, rows x width by rows
-  std::vector<double> values;
-  std::vector<int> local;  // blockCopy's work: a row's place in a block
-};
-
-// One chunk of W <= 8 of a supernode's columns, their values y_c in `chunk` (held in
-// registers meanwhile), and the block's rows after the chunk's own. Forward: the chunk's
-// triangle, then for each row r, y_r -= L_rc y_c. Backward: y_c -= (sum over the rows of
-// L_rc' y_r), then the chunk's triangle transposed. `v` is the chunk's first column in its
-// first row, `stride` the block's width, `diagonal` the chunk's inverse diagonal; T one double
-// or four lanes.
-template <typename T, int W>
-void forwardChunk(const int* rows, int count, const double* v, int stride, const double* diagonal,
-                  T* chunk, double* yd) {
-  T yc[W];
-  for (int k = 0; k < W; ++k) yc[k] = chunk[k];
-  for (int j = 0; j < W; ++j) {
-    yc[j] *= diagonal[j];
-    for (int k = j + 1; k < W; ++k) yc[k] -= v[k * stride + j] * yc[j];
-  }
-  for (int k = 0; k < W; ++k) chunk[k] = yc[k];
-  v += W * stride;
-  for (int q = 0; q < count; ++q, v += stride) {
-    T& yr = *reinterpret_cast<T*>(yd + rows[q]);
-    T sum = yr;
-    for (int k = 0; k < W; ++k) sum -= v[k] * yc[k];
-    yr = sum;
-  }
-}
-template <typename T, int W>
-void backwardChunk(const int* rows, int count, const double* v, int stride, const double* diagonal,
-                   T* chunk, const double* yd) {
-  T acc[W] = {};
-  const double* below = v + W * stride;
-  for (int q = 0; q < count; ++q, below += stride) {
-    const T yr = *reinterpret_cast<const T*>(yd + rows[q]);
-    for (int k = 0; k < W; ++k) acc[k] += below[k] * yr;
-  }
-  T yc[W];
-  for (int k = 0; k < W; ++k) yc[k] = chunk[k] - acc[k];
-  for (int j = W - 1; j >= 0; --j) {
-    yc[j] *= diagonal[j];
-    for (int k = 0; k < j; ++k) yc[k] -= v[j * stride + k] * yc[j];
-  }
-  for (int k = 0; k < W; ++k) chunk[k] = yc[k];
-}
-template <typename T, bool Forward, int W = 8>
-void chunk(int width, const int* rows, int count, const double* v, int stride,
-           const double* diagonal, T* values, double* yd) {
-  if constexpr (W > 1) {
-    if (width < W) {
-      return chunk<T, Forward, W - 1>(width, rows, count, v, stride, diagonal, values, yd);
-    }
-  }
-  if constexpr (Forward) {
-    forwardChunk<T, W>(rows, count, v, stride, diagonal, values, yd);
-  } else {
-    backwardChunk<T, W>(rows, count, v, stride, diagonal, values, yd);
-  }
-}
-
-// Forward substitution L y = y, then backward L^T z = y, in place, T one double or four lanes
-// (point i's entry at yd + kStride i): the supernodes before the tail, eight columns at a time,
-// push their solved values into the rows after them (the tail's rows included), the tail solves
-// both triangles over `work` (its rows side by side), and the supernodes, last first, pull the
-// solved values of the rows after them.
-template <typename T>
+// Forward substitution L y = y, then backward L^T z = y, in place (point i's entries at
+// yd + kStride i, `columns` of them): the supernodes before the tail push their solved values
+// into the rows after them (the tail's rows included), the tail solves both triangles over
+// `work` (its rows side by side), and the supernodes, last first, pull the solved values of the
+// rows after them.
 void substitute(int n, const SupernodeBlocks& b, const std::vector<double>& inverseDiagonal,
                 int tailStart, const DenseTail& tail, int columns, double* work, double* yd) {
-  constexpr int kChunk = 8;
-  const auto at = [yd](int point) -> T& { return *reinterpret_cast<T*>(yd + kStride * point); };
-  const int supernodes = static_cast<int>(b.start.size()) - 1;
-  for (int sn = 0; sn < supernodes; ++sn) {
-    const int c0 = b.start[sn], width = b.start[sn + 1] - c0;
-    const int* rows = b.rows.data() + b.rowStart[sn];
-    const int height = b.rowStart[sn + 1] - b.rowStart[sn];
-    const double* v = b.values.data() + b.valueStart[sn];
-    for (int j = 0; j < width; j += kChunk) {
-      T values[kChunk];
-      const int w = std::min(kChunk, width - j);
-      for (int k = 0; k < w; ++k) values[k] = at(c0 + j + k);
-      chunk<T, true>(w, rows + j + w, height - j - w, v + static_cast<long>(j) * width + j, width,
-                     inverseDiagonal.data() + c0 + j, values, yd);
-      for (int k = 0; k < w; ++k) at(c0 + j + k) = values[k];
-    }
-  }
+  b.forward(inverseDiagonal.data(), columns, yd);
   if (tailStart < n) {
     const int width = tail.paddedWidth();
     std::fill_n(work, static_cast<long>(columns) * width, 0.0);
@@ -129,20 +41,7 @@ void substitute(int n, const SupernodeBlocks& b, const std::vector<double>& inve
     for (int i = tailStart; i < n; ++i)
       for (int c = 0; c < columns; ++c) yd[kStride * i + c] = work[c * width + i - tailStart];
   }
-  for (int sn = supernodes - 1; sn >= 0; --sn) {
-    const int c0 = b.start[sn], width = b.start[sn + 1] - c0;
-    const int* rows = b.rows.data() + b.rowStart[sn];
-    const int height = b.rowStart[sn + 1] - b.rowStart[sn];
-    const double* v = b.values.data() + b.valueStart[sn];
-    for (int j = (width - 1) / kChunk * kChunk; j >= 0; j -= kChunk) {
-      T values[kChunk];
-      const int w = std::min(kChunk, width - j);
-      for (int k = 0; k < w; ++k) values[k] = at(c0 + j + k);
-      chunk<T, false>(w, rows + j + w, height - j - w, v + static_cast<long>(j) * width + j, width,
-                      inverseDiagonal.data() + c0 + j, values, yd);
-      for (int k = 0; k < w; ++k) at(c0 + j + k) = values[k];
-    }
-  }
+  b.backward(inverseDiagonal.data(), columns, yd);
 }
 
 }  // namespace
@@ -343,55 +242,7 @@ StepResult PrefactoredCholesky::factorize(const SparseMatrix& A,
 }
 
 void PrefactoredCholesky::blockCopy(bool samePattern) {
-  SupernodeBlocks& b = impl_->blocks;
-  const int supernodes = static_cast<int>(b.start.size()) - 1;
-  std::vector<int>& local = b.local;  // a row's place in the block being filled; -1: none
-  local.assign(static_cast<std::size_t>(n_), -1);
-  // The values into the blocks' pattern, supernode by supernode; false when an entry lies
-  // outside it (a new pattern).
-  const auto fill = [&] {
-    std::fill(b.values.begin(), b.values.end(), 0.0);
-    for (int sn = 0; sn < supernodes; ++sn) {
-      const int c0 = b.start[sn], c1 = b.start[sn + 1], width = c1 - c0;
-      const int first = b.rowStart[sn], height = b.rowStart[sn + 1] - first;
-      for (int q = 0; q < height; ++q) local[b.rows[first + q] / kStride] = q;
-      double* block = b.values.data() + b.valueStart[sn];
-      for (int j = c0; j < c1; ++j) {
-        for (int q = colStart_[j]; q < colStart_[j + 1]; ++q) {
-          const int row = local[static_cast<std::size_t>(colRow_[q])];
-          if (row < 0) return false;
-          block[static_cast<std::ptrdiff_t>(row) * width + (j - c0)] = colValue_[q];
-        }
-      }
-      for (int q = 0; q < height; ++q) local[b.rows[first + q] / kStride] = -1;
-    }
-    return true;
-  };
-  if (samePattern && fill()) return;
-  // The pattern: each supernode's own columns, then every row of its columns' entries from c1
-  // on (CHOLMOD's supernodes share them; the copy dropped explicit zeros, so the union is
-  // taken).
-  std::fill(local.begin(), local.end(), -1);
-  b.rowStart.assign(1, 0);
-  b.rows.clear();
-  b.valueStart.assign(1, 0);
-  for (int sn = 0; sn < supernodes; ++sn) {
-    const int c0 = b.start[sn], c1 = b.start[sn + 1], width = c1 - c0;
-    const std::size_t first = b.rows.size();
-    for (int j = c0; j < c1; ++j) b.rows.push_back(j);
-    for (int j = c0; j < c1; ++j)
-      for (int q = colStart_[j]; q < colStart_[j + 1]; ++q)
-        if (colRow_[q] >= c1) b.rows.push_back(colRow_[q]);
-    const auto below = b.rows.begin() + static_cast<std::ptrdiff_t>(first) + width;
-    std::sort(below, b.rows.end());
-    b.rows.erase(std::unique(below, b.rows.end()), b.rows.end());
-    for (std::size_t q = first; q < b.rows.size(); ++q) b.rows[q] *= kStride;  // as read
-    b.rowStart.push_back(static_cast<int>(b.rows.size()));
-    b.valueStart.push_back(b.valueStart.back() + static_cast<int>(b.rows.size() - first) * width);
-  }
-  b.values.assign(static_cast<std::size_t>(b.valueStart.back()), 0.0);
-  const bool filled = fill();
-  JELLO_ASSERT(filled, "every entry lies in the blocks' pattern made from them");
+  impl_->blocks.copy(n_, colStart_, colRow_, colValue_, samePattern);
   impl_->lanes.resize(static_cast<std::size_t>(n_));
 }
 
@@ -532,7 +383,7 @@ StepResult PrefactoredCholesky::solveFactored(double* b, int columns) const {
   if (columns == 1) {
     auto* y = reinterpret_cast<double*>(s.lanes.data());
     for (int k = 0; k < n; ++k) y[kStride * k] = b[perm_[k]];
-    substitute<double>(n, s.blocks, inverseDiagonal_, tailStart_, s.tail, 1, s.tail.workspace(), y);
+    substitute(n, s.blocks, inverseDiagonal_, tailStart_, s.tail, 1, s.tail.workspace(), y);
     for (int k = 0; k < n; ++k) b[perm_[k]] = y[kStride * k];
     return StepResult::success();
   }
@@ -541,8 +392,8 @@ StepResult PrefactoredCholesky::solveFactored(double* b, int columns) const {
     const int p = perm_[k];
     y[k] = Lanes{b[p], columns > 1 ? b[n + p] : 0.0, columns > 2 ? b[2 * n + p] : 0.0, 0.0};
   }
-  substitute<Lanes>(n, s.blocks, inverseDiagonal_, tailStart_, s.tail, columns, s.tail.workspace(),
-                    reinterpret_cast<double*>(y));
+  substitute(n, s.blocks, inverseDiagonal_, tailStart_, s.tail, columns, s.tail.workspace(),
+             reinterpret_cast<double*>(y));
   for (int k = 0; k < n; ++k) {
     const int p = perm_[k];
     b[p] = y[k][0];

@@ -3,11 +3,11 @@
 // of CG). CHOLMOD factors (supernodal, the best ordering of three); the solves then run over
 // a copy of the factor, in one of two forms by its size:
 // - up to copyLimit entries, the supernodes before the tail as dense blocks by rows (explicit
-//   zeros included), the three right-hand sides side by side in one 4-wide vector per point;
-//   the substitutions hold eight of a supernode's columns in registers while they run over its
-//   rows, so an entry of L costs one load and one multiply-add for all three columns; the
-//   factor's last supernodes (at 8^3 263 of 512 columns, 61% of L) as one dense triangle
-//   (solvers/dense_tail.h), read eight entries to a vector. Measured at 8^3 (512 points,
+//   zeros included; solvers/supernode_blocks.h), the three right-hand sides side by side in one
+//   4-wide vector per point; the substitutions hold eight of a supernode's columns in registers
+//   while they run over its rows, so an entry of L costs one load and one multiply-add for all
+//   three columns; the factor's last supernodes (at 8^3 263 of 512 columns, 61% of L) as one dense
+//   triangle (solvers/dense_tail.h), read eight entries to a vector. Measured at 8^3 (512 points,
 //   48,000 entries in L, three columns): 20 us, against 32 us for the copy without the tail
 //   and about 77 us for CHOLMOD's own solve (the blocks: 3-5% less than the copy by single
 //   entries at 8^3, 20% less at 10^3).
