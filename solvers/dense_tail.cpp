@@ -72,21 +72,24 @@ void backwardPanels(const DenseTail::Data& f, int width, double* y0) {
   double* y[C];
   for (int c = 0; c < C; ++c) y[c] = y0 + static_cast<long>(c) * width;
   for (int p = width - kPanel; p >= 0; p -= kPanel) {
-    // The panel's entries minus L's rows below it (by rows: the panel's eight columns to a
-    // vector) times their solved values, four rows at a time into four sums each (the
-    // additions of one sum wait for each other). The rows below come in whole panels.
-    Lanes sum[4][C] = {};
-    const double* l = f.byRow + p;
-    for (int r = p + kPanel; r < width; r += 4) {
-      for (int u = 0; u < 4; ++u) {
-        const Lanes lu = load(l + static_cast<long>(r + u) * width);
-        for (int c = 0; c < C; ++c) sum[u][c] += lu * y[c][r + u];
-      }
-    }
-    for (int c = 0; c < C; ++c) {
-      store(y[c] + p, load(y[c] + p) - ((sum[0][c] + sum[1][c]) + (sum[2][c] + sum[3][c])));
-    }
+    // The panel's values are final (the panels after it have pushed theirs): solve its
+    // transposed diagonal block, then push its solved values into the rows above it through
+    // L's rows p .. p + 7 (by rows: eight of their columns to a vector), the values held in
+    // registers while the columns go by.
     multiplyPanel<C>(f.inverseTransposed + static_cast<long>(p) * kPanel, y, p);
+    Lanes z[C][kPanel];
+    for (int c = 0; c < C; ++c)
+      for (int q = 0; q < kPanel; ++q) z[c][q] = Lanes{} + y[c][p + q];
+    const double* l = f.byRow + static_cast<long>(p) * width;  // row p
+    for (int j = 0; j < p; j += kPanel) {
+      Lanes sum[C];
+      for (int c = 0; c < C; ++c) sum[c] = load(y[c] + j);
+      for (int q = 0; q < kPanel; ++q) {
+        const Lanes lq = load(l + static_cast<long>(q) * width + j);
+        for (int c = 0; c < C; ++c) sum[c] -= lq * z[c][q];
+      }
+      for (int c = 0; c < C; ++c) store(y[c] + j, sum[c]);
+    }
   }
 }
 
