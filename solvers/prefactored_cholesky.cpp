@@ -28,9 +28,9 @@ static_assert(sizeof(Lanes) == kStride * sizeof(double));
 // into the rows after them (the tail's rows included), the tail solves both triangles over
 // `work` (its rows side by side), and the supernodes, last first, pull the solved values of the
 // rows after them.
-void substitute(int n, const SupernodeBlocks& b, const std::vector<double>& inverseDiagonal,
-                int tailStart, const DenseTail& tail, int columns, double* work, double* yd) {
-  b.forward(inverseDiagonal.data(), columns, yd);
+void substitute(int n, const SupernodeBlocks& b, int tailStart, const DenseTail& tail, int columns,
+                double* work, double* yd) {
+  b.forward(columns, yd);
   if (tailStart < n) {
     const int width = tail.paddedWidth();
     std::fill_n(work, static_cast<long>(columns) * width, 0.0);
@@ -41,7 +41,7 @@ void substitute(int n, const SupernodeBlocks& b, const std::vector<double>& inve
     for (int i = tailStart; i < n; ++i)
       for (int c = 0; c < columns; ++c) yd[kStride * i + c] = work[c * width + i - tailStart];
   }
-  b.backward(inverseDiagonal.data(), columns, yd);
+  b.backward(columns, yd);
 }
 
 }  // namespace
@@ -242,7 +242,7 @@ StepResult PrefactoredCholesky::factorize(const SparseMatrix& A,
 }
 
 void PrefactoredCholesky::blockCopy(bool samePattern) {
-  impl_->blocks.copy(n_, colStart_, colRow_, colValue_, samePattern);
+  impl_->blocks.copy(n_, colStart_, colRow_, colValue_, inverseDiagonal_, samePattern);
   impl_->lanes.resize(static_cast<std::size_t>(n_));
 }
 
@@ -383,7 +383,7 @@ StepResult PrefactoredCholesky::solveFactored(double* b, int columns) const {
   if (columns == 1) {
     auto* y = reinterpret_cast<double*>(s.lanes.data());
     for (int k = 0; k < n; ++k) y[kStride * k] = b[perm_[k]];
-    substitute(n, s.blocks, inverseDiagonal_, tailStart_, s.tail, 1, s.tail.workspace(), y);
+    substitute(n, s.blocks, tailStart_, s.tail, 1, s.tail.workspace(), y);
     for (int k = 0; k < n; ++k) b[perm_[k]] = y[kStride * k];
     return StepResult::success();
   }
@@ -392,7 +392,7 @@ StepResult PrefactoredCholesky::solveFactored(double* b, int columns) const {
     const int p = perm_[k];
     y[k] = Lanes{b[p], columns > 1 ? b[n + p] : 0.0, columns > 2 ? b[2 * n + p] : 0.0, 0.0};
   }
-  substitute(n, s.blocks, inverseDiagonal_, tailStart_, s.tail, columns, s.tail.workspace(),
+  substitute(n, s.blocks, tailStart_, s.tail, columns, s.tail.workspace(),
              reinterpret_cast<double*>(y));
   for (int k = 0; k < n; ++k) {
     const int p = perm_[k];

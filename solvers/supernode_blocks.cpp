@@ -14,19 +14,20 @@ static_assert(sizeof(Lanes) == kStride * sizeof(double));
 constexpr int kChunk = 8;
 
 // One chunk of W <= 8 of a supernode's columns, their values y_c in `chunk` (held in
-// registers meanwhile), and the block's rows after the chunk's own. Forward: the chunk's
-// triangle, then for each row r, y_r -= L_rc y_c. Backward: y_c -= (sum over the rows of
-// L_rc' y_r), then the chunk's triangle transposed. `v` is the chunk's first column in its
-// first row, `stride` the block's width, `diagonal` the chunk's inverse diagonal; T one double
-// or four lanes.
+// registers meanwhile), and the block's rows after the chunk's own. Forward: y_c = D^-1 y_c
+// with D the chunk's triangle, then for each row r, y_r -= L_rc y_c. Backward: y_c -= (sum over
+// the rows of L_rc' y_r), then y_c = D^-T y_c. `v` is the chunk's first column in its first
+// row, `stride` the block's width, `inverse` D^-1 (8 x 8 by rows): a product, its eight sums
+// independent and each in two halves, where substituting through D chained every column's
+// value to the one before; T one double or four lanes.
 template <typename T, int W>
-void forwardChunk(const int* rows, int count, const double* v, int stride, const double* diagonal,
+void forwardChunk(const int* rows, int count, const double* v, int stride, const double* inverse,
                   T* chunk, double* yd) {
   T yc[W];
-  for (int k = 0; k < W; ++k) yc[k] = chunk[k];
-  for (int j = 0; j < W; ++j) {
-    yc[j] *= diagonal[j];
-    for (int k = j + 1; k < W; ++k) yc[k] -= v[k * stride + j] * yc[j];
+  for (int k = W - 1; k >= 0; --k) {
+    T even = inverse[k * kChunk] * chunk[0], odd{};
+    for (int m = 1; m <= k; ++m) (m % 2 ? odd : even) += inverse[k * kChunk + m] * chunk[m];
+    yc[k] = even + odd;
   }
   for (int k = 0; k < W; ++k) chunk[k] = yc[k];
   v += W * stride;
@@ -38,7 +39,7 @@ void forwardChunk(const int* rows, int count, const double* v, int stride, const
   }
 }
 template <typename T, int W>
-void backwardChunk(const int* rows, int count, const double* v, int stride, const double* diagonal,
+void backwardChunk(const int* rows, int count, const double* v, int stride, const double* inverse,
                    T* chunk, const double* yd) {
   T acc[W] = {};
   const double* below = v + W * stride;
@@ -48,31 +49,33 @@ void backwardChunk(const int* rows, int count, const double* v, int stride, cons
   }
   T yc[W];
   for (int k = 0; k < W; ++k) yc[k] = chunk[k] - acc[k];
-  for (int j = W - 1; j >= 0; --j) {
-    yc[j] *= diagonal[j];
-    for (int k = 0; k < j; ++k) yc[k] -= v[j * stride + k] * yc[j];
+  for (int j = 0; j < W; ++j) {
+    T even = inverse[(W - 1) * kChunk + j] * yc[W - 1], odd{};
+    for (int k = W - 2; k >= j; --k) {
+      (k % 2 ? odd : even) += inverse[k * kChunk + j] * yc[k];
+    }
+    chunk[j] = even + odd;
   }
-  for (int k = 0; k < W; ++k) chunk[k] = yc[k];
 }
 template <typename T, bool Forward, int W = 8>
 void chunk(int width, const int* rows, int count, const double* v, int stride,
-           const double* diagonal, T* values, double* yd) {
+           const double* inverse, T* values, double* yd) {
   if constexpr (W > 1) {
     if (width < W) {
-      return chunk<T, Forward, W - 1>(width, rows, count, v, stride, diagonal, values, yd);
+      return chunk<T, Forward, W - 1>(width, rows, count, v, stride, inverse, values, yd);
     }
   }
   if constexpr (Forward) {
-    forwardChunk<T, W>(rows, count, v, stride, diagonal, values, yd);
+    forwardChunk<T, W>(rows, count, v, stride, inverse, values, yd);
   } else {
-    backwardChunk<T, W>(rows, count, v, stride, diagonal, values, yd);
+    backwardChunk<T, W>(rows, count, v, stride, inverse, values, yd);
   }
 }
 
 }  // namespace
 
 template <typename T, bool Forward>
-void SupernodeBlocks::sweep(int sn, const double* inverseDiagonal, double* yd) const {
+void SupernodeBlocks::sweep(int sn, double* yd) const {
   const auto at = [yd](int point) -> T& { return *reinterpret_cast<T*>(yd + kStride * point); };
   const int c0 = start[sn], width = start[sn + 1] - c0;
   const int* rows = rows_.data() + rowStart_[sn];
@@ -85,34 +88,35 @@ void SupernodeBlocks::sweep(int sn, const double* inverseDiagonal, double* yd) c
     const int w = std::min(kChunk, width - j);
     for (int k = 0; k < w; ++k) values[k] = at(c0 + j + k);
     chunk<T, Forward>(w, rows + j + w, height - j - w, v + static_cast<long>(j) * width + j, width,
-                      inverseDiagonal + c0 + j, values, yd);
+                      inverses_.data() + static_cast<long>(kChunk) * (c0 + j), values, yd);
     for (int k = 0; k < w; ++k) at(c0 + j + k) = values[k];
   }
 }
 
-void SupernodeBlocks::forward(const double* inverseDiagonal, int columns, double* yd) const {
+void SupernodeBlocks::forward(int columns, double* yd) const {
   const int supernodes = static_cast<int>(start.size()) - 1;
   for (int sn = 0; sn < supernodes; ++sn) {
     if (columns == 1) {
-      sweep<double, true>(sn, inverseDiagonal, yd);
+      sweep<double, true>(sn, yd);
     } else {
-      sweep<Lanes, true>(sn, inverseDiagonal, yd);
+      sweep<Lanes, true>(sn, yd);
     }
   }
 }
 
-void SupernodeBlocks::backward(const double* inverseDiagonal, int columns, double* yd) const {
+void SupernodeBlocks::backward(int columns, double* yd) const {
   for (int sn = static_cast<int>(start.size()) - 2; sn >= 0; --sn) {
     if (columns == 1) {
-      sweep<double, false>(sn, inverseDiagonal, yd);
+      sweep<double, false>(sn, yd);
     } else {
-      sweep<Lanes, false>(sn, inverseDiagonal, yd);
+      sweep<Lanes, false>(sn, yd);
     }
   }
 }
 
 void SupernodeBlocks::copy(int n, const std::vector<int>& colStart, const std::vector<int>& colRow,
-                           const std::vector<double>& colValue, bool samePattern) {
+                           const std::vector<double>& colValue,
+                           const std::vector<double>& inverseDiagonal, bool samePattern) {
   const int supernodes = static_cast<int>(start.size()) - 1;
   std::vector<int>& local = local_;  // a row's place in the block being filled; -1: none
   local.assign(static_cast<std::size_t>(n), -1);
@@ -136,7 +140,7 @@ void SupernodeBlocks::copy(int n, const std::vector<int>& colStart, const std::v
     }
     return true;
   };
-  if (samePattern && fill()) return;
+  if (samePattern && fill()) return invertChunks(inverseDiagonal);
   // The pattern: each supernode's own columns, then every row of its columns' entries from c1
   // on (CHOLMOD's supernodes share them; the copy dropped explicit zeros, so the union is
   // taken).
@@ -161,6 +165,32 @@ void SupernodeBlocks::copy(int n, const std::vector<int>& colStart, const std::v
   values_.assign(static_cast<std::size_t>(valueStart_.back()), 0.0);
   const bool filled = fill();
   JELLO_ASSERT(filled, "every entry lies in the blocks' pattern made from them");
+  invertChunks(inverseDiagonal);
+}
+
+void SupernodeBlocks::invertChunks(const std::vector<double>& inverseDiagonal) {
+  const int supernodes = static_cast<int>(start.size()) - 1;
+  inverses_.assign(static_cast<std::size_t>(kChunk) * static_cast<std::size_t>(start.back()), 0.0);
+  for (int sn = 0; sn < supernodes; ++sn) {
+    const int c0 = start[sn], width = start[sn + 1] - c0;
+    const double* v = values_.data() + valueStart_[sn];
+    for (int j = 0; j < width; j += kChunk) {
+      // D's inverse by rows, row k from D's row k and the rows before it (forward substitution
+      // on the identity's columns, all at once).
+      const int w = std::min(kChunk, width - j);
+      double* inverse = inverses_.data() + static_cast<long>(kChunk) * (c0 + j);
+      for (int k = 0; k < w; ++k) {
+        const double* row = v + static_cast<long>(j + k) * width + j;  // D's row k
+        double* out = inverse + k * kChunk;
+        for (int m = 0; m < k; ++m) {
+          double sum = 0.0;
+          for (int i = m; i < k; ++i) sum -= row[i] * inverse[i * kChunk + m];
+          out[m] = sum * inverseDiagonal[static_cast<std::size_t>(c0 + j + k)];
+        }
+        out[k] = inverseDiagonal[static_cast<std::size_t>(c0 + j + k)];
+      }
+    }
+  }
 }
 
 }  // namespace jello
