@@ -129,19 +129,14 @@ void DenseTail::copy(const double* block, int width) {
         f.byRow[static_cast<std::size_t>(r) * wp + j] = v;
       }
     }
-    // The diagonal block's inverse, column by column: forward substitution on the identity.
-    double* inverse = f.inverse + static_cast<long>(p) * kPanel;
-    for (int k = 0; k < kPanel; ++k) {
-      double* x = inverse + k * kPanel;  // column k
-      for (int i = 0; i < kPanel; ++i) {
-        double sum = i == k ? 1.0 : 0.0;
-        for (int s = 0; s < i; ++s) sum -= entry(p + i, p + s) * x[s];
-        x[i] = sum / entry(p + i, p + i);
-      }
-    }
+    // The diagonal block's inverse by rows (the transpose's by columns), then by columns.
     double* transposed = f.inverseTransposed + static_cast<long>(p) * kPanel;
+    invertLowerTriangle(
+        kPanel, [&](int i, int j) { return entry(p + i, p + j); },
+        [&](int i) { return entry(p + i, p + i); }, transposed);
+    double* inverse = f.inverse + static_cast<long>(p) * kPanel;
     for (int i = 0; i < kPanel; ++i)
-      for (int k = 0; k < kPanel; ++k) transposed[k * kPanel + i] = inverse[i * kPanel + k];
+      for (int k = 0; k < kPanel; ++k) inverse[i * kPanel + k] = transposed[k * kPanel + i];
   }
 }
 

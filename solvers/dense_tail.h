@@ -19,6 +19,12 @@ namespace jello {
 // the diagonal included).
 long supernodeEntries(const cholmod_factor_struct& L, std::size_t sn);
 
+// The inverse of a w x w lower triangle (w <= DenseTail::kPanel) by rows, row i at
+// out + kPanel i: forward substitution on the identity's columns, from the entries below the
+// diagonal lower(i, j) (i > j) and the diagonal diagonal(i).
+template <typename Lower, typename Diagonal>
+void invertLowerTriangle(int w, const Lower& lower, const Diagonal& diagonal, double* out);
+
 class DenseTail {
  public:
   static constexpr int kPanel = 8;
@@ -56,5 +62,17 @@ class DenseTail {
   Data data_;
   int paddedWidth_ = 0;
 };
+
+template <typename Lower, typename Diagonal>
+void invertLowerTriangle(int w, const Lower& lower, const Diagonal& diagonal, double* out) {
+  constexpr int stride = DenseTail::kPanel;
+  for (int k = 0; k < w; ++k) {  // column k
+    for (int i = 0; i < w; ++i) {
+      double sum = i == k ? 1.0 : 0.0;
+      for (int s = 0; s < i; ++s) sum -= lower(i, s) * out[s * stride + k];
+      out[i * stride + k] = sum / diagonal(i);
+    }
+  }
+}
 
 }  // namespace jello

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstddef>
 
+#include "solvers/dense_tail.h"
 #include "src/assertions.h"
 
 namespace jello {
@@ -11,7 +12,7 @@ namespace {
 using Lanes = double __attribute__((vector_size(32)));
 constexpr int kStride = kSubstitutionStride;
 static_assert(sizeof(Lanes) == kStride * sizeof(double));
-constexpr int kChunk = 8;
+constexpr int kChunk = DenseTail::kPanel;  // what invertLowerTriangle writes
 
 // One chunk of W <= 8 of a supernode's columns, their values y_c in `chunk` (held in
 // registers meanwhile), and the block's rows after the chunk's own. Forward: y_c = D^-1 y_c
@@ -175,20 +176,11 @@ void SupernodeBlocks::invertChunks(const std::vector<double>& inverseDiagonal) {
     const int c0 = start[sn], width = start[sn + 1] - c0;
     const double* v = values_.data() + valueStart_[sn];
     for (int j = 0; j < width; j += kChunk) {
-      // D's inverse by rows, row k from D's row k and the rows before it (forward substitution
-      // on the identity's columns, all at once).
-      const int w = std::min(kChunk, width - j);
-      double* inverse = inverses_.data() + static_cast<long>(kChunk) * (c0 + j);
-      for (int k = 0; k < w; ++k) {
-        const double* row = v + static_cast<long>(j + k) * width + j;  // D's row k
-        double* out = inverse + k * kChunk;
-        for (int m = 0; m < k; ++m) {
-          double sum = 0.0;
-          for (int i = m; i < k; ++i) sum -= row[i] * inverse[i * kChunk + m];
-          out[m] = sum * inverseDiagonal[static_cast<std::size_t>(c0 + j + k)];
-        }
-        out[k] = inverseDiagonal[static_cast<std::size_t>(c0 + j + k)];
-      }
+      const double* d = v + static_cast<long>(j) * width + j;  // D, the chunk's triangle
+      invertLowerTriangle(
+          std::min(kChunk, width - j), [&](int i, int m) { return d[i * width + m]; },
+          [&](int i) { return 1.0 / inverseDiagonal[static_cast<std::size_t>(c0 + j + i)]; },
+          inverses_.data() + static_cast<long>(kChunk) * (c0 + j));
     }
   }
 }
