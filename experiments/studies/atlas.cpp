@@ -3,12 +3,16 @@
 #include <Eigen/Dense>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 
+#include "experiments/studies/reference_file.h"
 #include "experiments/studies/stability_analysis.h"
+#include "experiments/studies/trajectory_run.h"
 #include "solvers/simulation.h"
 #include "src/integrator_name.h"
 #include "src/lattice.h"
+#include "src/parallel.h"
 #include "src/scene_builder.h"
 
 namespace jello::experiments {
@@ -145,7 +149,63 @@ Attempt attempt(const World& w, IntegratorKind kind, double dt, const SolverOpti
 
 }  // namespace
 
-AtlasReference atlasReference(const World& w, const AtlasSetup& setup) {
+namespace {
+
+// The model's threads set for a scope, and restored after.
+class ThreadsFor {
+ public:
+  explicit ThreadsFor(int threads) : saved_(parallelThreads()) {
+    if (threads > 0) setParallelThreads(threads);
+  }
+  ~ThreadsFor() { setParallelThreads(saved_); }
+  ThreadsFor(const ThreadsFor&) = delete;
+  ThreadsFor& operator=(const ThreadsFor&) = delete;
+
+ private:
+  int saved_;
+};
+
+// RK4 at key.dt over the window from w's initial state: the visible motion at every sample,
+// read from, resumed from and written to the reference directory when there is one.
+std::vector<Fit> referenceFits(const World& w, const TrajectoryKey& key, const AtlasSetup& setup,
+                               const VisibleMotion& visible) {
+  const std::filesystem::path file =
+      setup.referenceDir.empty() ? std::filesystem::path() : setup.referenceDir / key.fileName();
+  std::vector<Fit> fits;
+  Simulation sim(w, IntegratorKind::RK4, key.dt);
+  if (!file.empty()) {
+    if (std::optional<StoredTrajectory> stored = readTrajectory(file, key)) {
+      fits = std::move(stored->fits);
+      if (!stored->resume) return fits;
+      std::fprintf(stderr, "jello-scaling: %s: resuming at t = %g s of %g\n", file.c_str(),
+                   stored->resume->t, key.time);
+      sim.editableState() = *stored->resume;
+      sim.stateEdited();
+    }
+  }
+  if (fits.empty()) fits.push_back(visible.fit(sim.state()));
+  const long perSample = std::max(1L, std::lround(key.interval / key.dt));
+  const long samples = std::lround(key.time / key.interval);
+  auto saved = Clock::now();
+  for (long k = long(fits.size()); k <= samples; ++k) {
+    for (long i = 0; i < perSample; ++i) {
+      const StepResult r = sim.step();
+      if (!r.ok) throw std::runtime_error("atlas reference: " + r.message);
+    }
+    fits.push_back(visible.fit(sim.state()));
+    if (!file.empty() && k < samples && secondsSince(saved) >= setup.checkpoint) {
+      writeTrajectory(file, key, fits, &sim.state());
+      saved = Clock::now();
+    }
+  }
+  if (!file.empty()) writeTrajectory(file, key, fits, nullptr);
+  return fits;
+}
+
+}  // namespace
+
+AtlasReference atlasReference(const World& w, double k, AtlasScene scene, const AtlasSetup& setup) {
+  const ThreadsFor threads(setup.referenceThreads);
   AtlasReference ref;
   ref.wMax = maxAngularFrequency(Model(w), initialState(w));
   ref.dt =
@@ -153,14 +213,18 @@ AtlasReference atlasReference(const World& w, const AtlasSetup& setup) {
       std::pow(2.0,
                std::max(0.0, std::ceil(std::log2(setup.interval * ref.wMax / setup.referenceHw))));
   const VisibleMotion visible(w.cubeResolution);
-  AtlasSetup unlimited = setup;
-  unlimited.runBudget = std::numeric_limits<double>::infinity();
-  const Attempt run =
-      attempt(w, IntegratorKind::RK4, ref.dt, {}, unlimited, visible, nullptr, &ref.samples);
-  if (!run.finished) throw std::runtime_error("atlas reference: " + run.why);
-  const Attempt check = attempt(w, IntegratorKind::RK4, 2 * ref.dt, {}, unlimited, visible, &ref);
-  if (!check.finished) throw std::runtime_error("atlas reference check: " + check.why);
-  ref.check = check.error;
+  TrajectoryKey key{scene == AtlasScene::Falling ? "falling" : "free",
+                    k,
+                    w.cubeResolution,
+                    ref.dt,
+                    setup.interval,
+                    setup.time};
+  ref.samples = referenceFits(w, key, setup, visible);
+  key.dt = 2.0 * ref.dt;
+  const std::vector<Fit> check = referenceFits(w, key, setup, visible);
+  for (std::size_t i = 0; i < check.size(); ++i) {
+    ref.check = std::max(ref.check, visible.cornerDistance(check[i], ref.samples[i]));
+  }
   return ref;
 }
 

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +28,12 @@ struct AtlasSetup {
   double referenceHw = 1.0;  // h w_max of the reference's RK4 steps
   double runBudget = 20.0;   // wall seconds: a run that would take longer ends the search
   int halvings = 7;          // step sizes tried per integrator (explicit: below its limit)
+  // Where references are kept (reference_file.h; empty: nowhere): one found there is used, one
+  // computed is written there, and while it is computed its last state every `checkpoint` wall
+  // seconds, from which a later run resumes.
+  std::filesystem::path referenceDir;
+  double checkpoint = 60.0;
+  int referenceThreads = 0;  // the model's threads for the reference (0: the runs' own)
 };
 
 // The atlas's scenes: `falling` (the default) is the cube thrown sideways and spinning, falling
@@ -59,7 +66,8 @@ struct AtlasReference {
   double dt = 0.0;                                   // s
   double check = 0.0;  // m, the largest corner distance from RK4 at twice the reference's step
 };
-AtlasReference atlasReference(const World& w, const AtlasSetup& setup);
+// The reference of `scene` at stiffness k (`w`, atlasScene's), and its check.
+AtlasReference atlasReference(const World& w, double k, AtlasScene scene, const AtlasSetup& setup);
 
 // The integrators an atlas point compares (quick: symplectic, rk4, implicit, midpoint,
 // projective).

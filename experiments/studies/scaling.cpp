@@ -6,7 +6,7 @@
 // Also the crossover atlas (atlas.h): over k and N, each integrator's cost at the largest step
 // that keeps the visible motion within a tolerance.
 //   jello-scaling [--quick] [--n LIST] [--budget S] [--atlas-k LIST] [--atlas-n LIST]
-//                 [--atlas-scene falling|free]
+//                 [--atlas-scene falling|free] [--atlas-references DIR]
 //                 [--out-dir DIR] [--jobs N]
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -106,6 +106,19 @@ int main(int argc, char** argv) {
                  "Wall seconds of one atlas run beyond which smaller steps are not tried")
       ->check(jello::cli::positive())
       ->capture_default_str();
+  std::string referenceDir;
+  app.add_option("--atlas-references", referenceDir,
+                 "Directory the atlas's RK4 references are read from, or written to once computed "
+                 "(with their last state every --atlas-checkpoint s meanwhile: a stopped run "
+                 "resumes there)");
+  app.add_option("--atlas-checkpoint", atlas.checkpoint,
+                 "Wall seconds between the saved states of a reference being computed")
+      ->check(jello::cli::positive())
+      ->capture_default_str();
+  app.add_option("--atlas-reference-threads", atlas.referenceThreads,
+                 "Threads of the model while a reference is computed, with --jobs 1 (default: the "
+                 "runs' own, JELLO_THREADS or the CPUs)")
+      ->check(jello::cli::range(1, 64));
   app.add_flag_function(
       "--no-atlas", [&](std::int64_t) { atlasK.clear(); }, "Leave the atlas out");
   bool noGrid = false;
@@ -122,10 +135,21 @@ int main(int argc, char** argv) {
     // Under mpirun every rank parses the same line: rank 0 alone prints, all exit alike.
     return (ranks.root() ? app.exit(e) : e.get_exit_code()) == 0 ? 0 : 2;
   }
+  if (atlas.referenceThreads > 0 && jobs > 1) {
+    if (ranks.root()) {
+      std::cerr << "jello-scaling: error: --atlas-reference-threads needs --jobs 1 (with several "
+                   "jobs each holds a CPU)\n";
+    }
+    return 2;
+  }
   // The tree as the run starts: the code that ran (outputs written later do not count).
   const nlohmann::json context = runContext(argc, argv);
   // The output directory is made and checked before the (long) run.
   if (!ranks.prepareOutput("jello-scaling", outDir, name)) return 1;
+  atlas.referenceDir = referenceDir;
+  if (!referenceDir.empty() && !ranks.prepareOutput("jello-scaling", referenceDir, "reference")) {
+    return 1;
+  }
   if (quick) {
     if (app.count("--n") == 0) ns = {6, 8};
     if (app.count("--budget") == 0) budget = 0.3;
@@ -176,7 +200,7 @@ int main(int argc, char** argv) {
         if (i >= int(tasks.size())) {
           const auto [ak, an] = atlasPoints[static_cast<std::size_t>(i) - tasks.size()];
           const World w = atlasScene(ak, an, scene);
-          const AtlasReference reference = atlasReference(w, atlas);
+          const AtlasReference reference = atlasReference(w, ak, scene, atlas);
           for (IntegratorKind kind : atlasIntegrators(quick)) {
             atlasPoint(w, ak, an, kind, reference, atlas, atlasRows);
           }
@@ -244,6 +268,8 @@ int main(int argc, char** argv) {
          "the least-squares affine map of the rest lattice, compared at the 8 corners"},
         {"reference", "rk4"},
         {"reference_h_w_max", atlas.referenceHw},
+        {"reference_dir", referenceDir},
+        {"reference_threads", atlas.referenceThreads},
         {"run_budget_s", atlas.runBudget},
         {"steps_tried", atlas.halvings},
         {"explicit_start", "0.9 times the predicted limit"},
