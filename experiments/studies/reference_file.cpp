@@ -132,7 +132,7 @@ std::optional<StoredTrajectory> readTrajectory(const std::filesystem::path& file
   if (lines.token(0) == "state") {
     const long points = long(key.n) * key.n * key.n;
     if (lines.size() != 3) lines.fail("'state' takes the time and the number of points");
-    if (lines.count(2, points) != points) {
+    if (lines.number(2) != double(points)) {
       lines.fail("a state of " + lines.token(2) + " points, not " + std::to_string(points));
     }
     State s;

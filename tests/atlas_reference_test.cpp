@@ -1,0 +1,200 @@
+// The atlas's references kept on disk (reference_file.h, jello-scaling --atlas-references): a
+// file reads back to the bit, a file made for another point or damaged is refused with its
+// line and token, and a reference stored, resumed from a saved state or computed at once is the
+// same to the bit (RK4 keeps no history), so that hours of N = 32 may span several runs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include "experiments/studies/atlas.h"
+#include "experiments/studies/reference_file.h"
+#include "solvers/simulation.h"
+#include "src/parallel.h"
+#include "tests/experiments_support.h"
+#include "tests/test_support.h"
+
+namespace jello::experiments {
+namespace {
+
+TrajectoryKey smallKey() {
+  return {"falling", 1e3, 2, 3.0517578125e-4, 0.02, 0.1};
+}
+
+std::vector<AffineFit> randomFits(int count) {
+  std::mt19937 random(7);
+  std::normal_distribution<double> normal;
+  std::vector<AffineFit> fits(std::size_t(count), AffineFit::Zero());
+  for (AffineFit& f : fits) {
+    for (int i = 0; i < 12; ++i) f(i % 3, i / 3) = normal(random) * std::pow(10.0, i - 6);
+  }
+  return fits;
+}
+
+std::string slurp(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The message of readTrajectory's refusal of `text` (empty: none).
+std::string refusal(const std::filesystem::path& file, const std::string& text,
+                    const TrajectoryKey& key) {
+  std::ofstream(file) << text;
+  try {
+    readTrajectory(file, key);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return {};
+}
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
+
+TEST(ReferenceFile, ReadsBackToTheBitAndRefusesAnythingElse) {
+  test::TempDir dir;
+  const TrajectoryKey key = smallKey();
+  const std::filesystem::path file = dir.path() / key.fileName();
+  EXPECT_FALSE(readTrajectory(file, key).has_value());  // none yet
+
+  // Unfinished: three fits and the state at the third (t = 0.04 s), 8 points.
+  const std::vector<AffineFit> fits = randomFits(3);
+  State s;
+  s.t = 2 * 0.02;
+  s.x = Eigen::VectorXd::Random(24) * 1e3;
+  s.v = Eigen::VectorXd::Random(24) * 1e-9;
+  writeTrajectory(file, key, fits, &s);
+  std::optional<StoredTrajectory> back = readTrajectory(file, key);
+  ASSERT_TRUE(back && back->resume);
+  ASSERT_EQ(back->fits.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(back->fits[i], fits[i]);
+  EXPECT_EQ(back->resume->t, s.t);
+  EXPECT_EQ(back->resume->x, s.x);
+  EXPECT_EQ(back->resume->v, s.v);
+
+  // Finished: all six fits, no state.
+  const std::vector<AffineFit> all = randomFits(6);
+  writeTrajectory(file, key, all, nullptr);
+  back = readTrajectory(file, key);
+  ASSERT_TRUE(back);
+  EXPECT_FALSE(back->resume);
+  ASSERT_EQ(back->fits.size(), 6u);
+  EXPECT_EQ(back->fits[5], all[5]);
+  const std::string good = slurp(file);
+
+  // Made for another point: the field that differs, with the file and its line.
+  TrajectoryKey other = key;
+  other.k = 1e4;
+  std::string why = refusal(file, good, other);
+  EXPECT_NE(why.find(file.string() + ":3: made for k_N_per_m = 1000, not 10000"), std::string::npos)
+      << why;
+  other = key;
+  other.scene = "free";
+  EXPECT_NE(refusal(file, good, other).find(":2: made for the scene 'falling', not 'free'"),
+            std::string::npos);
+  other = key;
+  other.dt *= 2;
+  EXPECT_NE(refusal(file, good, other).find(":5: made for dt_s"), std::string::npos);
+
+  // Damaged: the token and its line.
+  const auto damaged = [&](const std::string& from, const std::string& to) {
+    return refusal(file, replaced(good, from, to), key);
+  };
+  why = damaged("fits 6\n", "fits 6\n1 2 3 4 5 6 7 8 9 10 11 1.5x\n");
+  EXPECT_NE(why.find(":9: '1.5x' is not a finite number"), std::string::npos) << why;
+  why = damaged("fits 6\n", "fits 6\n1 2 3 4 5 6 7 8 9 10 11 nan\n");
+  EXPECT_NE(why.find(":9: 'nan' is not a finite number"), std::string::npos) << why;
+  why = damaged("fits 6\n", "fits 7\n");
+  EXPECT_NE(why.find(":8: '7' is not a count from 0 to 6"), std::string::npos) << why;
+  why = damaged("fits 6\n", "fits 5\n");
+  EXPECT_NE(why.find(":14: unfinished (5 of 6 fits) and without the state"), std::string::npos)
+      << why;
+  why = damaged("end\n", "");
+  EXPECT_NE(why.find("the file ends early, before 'end'"), std::string::npos) << why;
+  why = damaged("end\n", "end\nmore\n");
+  EXPECT_NE(why.find("'more' after 'end'"), std::string::npos) << why;
+  why = refusal(file, good.substr(0, good.find("fits")), key);
+  EXPECT_NE(why.find("the file ends early, before 'fits'"), std::string::npos) << why;
+
+  // Unfinished without its state, or with a state that is not the last fit's.
+  writeTrajectory(file, key, fits, nullptr);
+  why = refusal(file, slurp(file), key);
+  EXPECT_NE(why.find("unfinished (3 of 6 fits) and without the state"), std::string::npos) << why;
+  s.t = 0.06;
+  writeTrajectory(file, key, fits, &s);
+  why = refusal(file, slurp(file), key);
+  EXPECT_NE(why.find("is not that of the last fit"), std::string::npos) << why;
+  s.t = 0.04;
+  writeTrajectory(file, key, fits, &s);
+  why = refusal(file, replaced(slurp(file), "state 0.040000000000000001 8", "state 0.04 9"), key);
+  EXPECT_NE(why.find("a state of 9 points, not 8"), std::string::npos) << why;
+}
+
+// A reference computed at once, computed into a directory, read back from it, and resumed from
+// a saved state are the same to the bit; the model's threads come back after it.
+TEST(AtlasReference, StoredAndResumedReferencesEqualTheOneComputedAtOnce) {
+  const World w = atlasScene(1e3, 8, AtlasScene::Falling);
+  AtlasSetup setup;
+  setup.time = 0.1;
+  const AtlasReference once = atlasReference(w, 1e3, AtlasScene::Falling, setup);
+  ASSERT_EQ(once.samples.size(), 6u);
+  EXPECT_GT(once.check, 0.0);
+  EXPECT_LT(once.check, 1e-4);
+
+  test::TempDir dir;
+  setup.referenceDir = dir.path();
+  setup.checkpoint = 0.0;  // a state after every fit
+  const int threads = parallelThreads();
+  setup.referenceThreads = threads + 1;
+  const AtlasReference stored = atlasReference(w, 1e3, AtlasScene::Falling, setup);
+  EXPECT_EQ(parallelThreads(), threads);
+  const TrajectoryKey key{"falling", 1e3, 8, once.dt, setup.interval, setup.time};
+  const std::filesystem::path file = dir.path() / key.fileName();
+  ASSERT_TRUE(std::filesystem::exists(file));
+  TrajectoryKey checkKey = key;
+  checkKey.dt *= 2;
+  ASSERT_TRUE(std::filesystem::exists(dir.path() / checkKey.fileName()));
+  EXPECT_FALSE(readTrajectory(file, key)->resume);  // finished: the state is gone
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_EQ(stored.samples[i], once.samples[i]) << i;
+  EXPECT_EQ(stored.check, once.check);
+
+  // Read back, not computed: a finished check equal to the reference checks to exactly 0.
+  writeTrajectory(dir.path() / checkKey.fileName(), checkKey, once.samples, nullptr);
+  EXPECT_EQ(atlasReference(w, 1e3, AtlasScene::Falling, setup).check, 0.0);
+
+  // Resumed: the state at t = 0.04 s (two samples of RK4 steps) with the fits before it, the
+  // fit at 0.02 s marked so that a recomputation would show.
+  Simulation sim(w, IntegratorKind::RK4, once.dt);
+  for (long i = 0; i < 2 * std::lround(setup.interval / once.dt); ++i) ASSERT_TRUE(sim.step().ok);
+  std::vector<AffineFit> partial(once.samples.begin(), once.samples.begin() + 3);
+  partial[1](0, 3) += 1.0;
+  writeTrajectory(file, key, partial, &sim.state());
+  std::filesystem::remove(dir.path() / checkKey.fileName());
+  const AtlasReference resumed = atlasReference(w, 1e3, AtlasScene::Falling, setup);
+  EXPECT_EQ(resumed.samples[1](0, 3), once.samples[1](0, 3) + 1.0);  // kept from the file
+  for (std::size_t i : {0u, 2u, 3u, 4u, 5u}) EXPECT_EQ(resumed.samples[i], once.samples[i]) << i;
+}
+
+TEST(ScalingCli, ReferenceThreadsNeedOneJob) {
+  test::TempDir dir;
+  EXPECT_EQ(run(std::string(JELLO_SCALING) + " --quick --no-grid --jobs 2 " +
+                "--atlas-reference-threads 2 --out-dir " + dir.path().string()),
+            2);
+  // A reference directory that cannot be made fails before the run.
+  std::ofstream(dir.path() / "file") << "x";
+  EXPECT_EQ(run(std::string(JELLO_SCALING) + " --quick --no-grid --atlas-references " +
+                (dir.path() / "file" / "refs").string() + " --out-dir " + dir.path().string()),
+            1);
+}
+
+}  // namespace
+}  // namespace jello::experiments
