@@ -417,8 +417,13 @@ def experiments_runtime():
             f"VMs ({each}; each sidecar's `wall_time_s`, machine and date).")
     # The atlas-only runs (scripts/run-experiments.sh atlas), one or more per N: (N, the run's
     # k when N has several, minutes).
+    # A run whose reference had threads of its own (--atlas-reference-threads) says so.
+    def threads(sidecar):
+        count = sidecar["parameters"]["atlas"].get("reference_threads", 0)
+        return count if count > 1 else 0
+
     extra = [(n, sidecar["parameters"]["atlas"]["k_N_per_m"] if len(sidecars) > 1 else None,
-              sidecar["wall_time_s"] / 60)
+              sidecar["wall_time_s"] / 60, threads(sidecar))
              for n, (_, sidecars) in sorted(atlas_sources().items()) for sidecar in sidecars
              if not sidecar["parameters"]["n"]]
     if extra:
@@ -427,8 +432,11 @@ def experiments_runtime():
                 return f"N = {n}"
             span = k_text(ks[0]) + ("" if len(ks) == 1 else f" to {k_text(ks[-1])}")
             return f"N = {n} at k = {span}"
-        text += (" The atlas at " + " and ".join(which(n, ks) for n, ks, _ in extra) +
-                 " took " + " and ".join(f"{t:.0f} min" for _, _, t in extra) +
+        text += (" The atlas at " + " and ".join(which(n, ks) for n, ks, _, _ in extra) +
+                 " took " + " and ".join(
+                     f"{t:.0f} min" + (f" (its reference on {r} threads)" if r else "")
+                     for _, _, t, r in extra) +
+                 (", the timed runs" if any(r for *_, r in extra) else "") +
                  ", each on one core of the same machine.")
     free = sorted((n, sidecar["wall_time_s"], sidecar["parameters"]["jobs"])
                   for n, (_, sidecars) in atlas_sources(ATLAS_FREE).items()

@@ -25,6 +25,10 @@ std::optional<AtlasScene> parseAtlasScene(const std::string& name) {
   return std::nullopt;
 }
 
+std::string sceneName(AtlasScene scene) {
+  return scene == AtlasScene::Falling ? "falling" : "free";
+}
+
 std::string describe(AtlasScene scene) {
   return scene == AtlasScene::Falling
              ? "cube at rest shape thrown at 0.5 m/s and spinning 2 rad/s about z, falling 1.5 m "
@@ -110,15 +114,13 @@ struct Attempt {
 };
 
 // `kind` at dt (cvode: the sample interval) over the window, the visible motion compared with
-// `reference` (none: the fits are returned in `fits`).
+// the reference's.
 Attempt attempt(const World& w, IntegratorKind kind, double dt, const SolverOptions& options,
                 const AtlasSetup& setup, const VisibleMotion& visible,
-                const AtlasReference* reference, std::vector<Fit>* fits = nullptr) {
-  using Clock = std::chrono::steady_clock;
+                const AtlasReference& reference) {
   Simulation sim(w, kind, dt, options);
   const long perSample = std::max(1L, std::lround(setup.interval / dt));
   const long samples = std::lround(setup.time / setup.interval);
-  if (fits) fits->push_back(visible.fit(sim.state()));
   Attempt a;
   double wall = 0.0;
   for (long k = 1; k <= samples; ++k) {
@@ -130,26 +132,19 @@ Attempt attempt(const World& w, IntegratorKind kind, double dt, const SolverOpti
         return a;
       }
     }
-    wall += std::chrono::duration<double>(Clock::now() - t0).count();
+    wall += secondsSince(t0);
     if (wall > setup.runBudget) {
       a.why = "over the run budget";
       return a;
     }
-    const Fit f = visible.fit(sim.state());
-    if (fits) fits->push_back(f);
-    if (reference) {
-      a.error = std::max(a.error, visible.cornerDistance(f, reference->samples[std::size_t(k)]));
-    }
+    a.error = std::max(a.error, visible.cornerDistance(visible.fit(sim.state()),
+                                                       reference.samples[std::size_t(k)]));
   }
   a.finished = true;
   a.wallPerSecond = wall / setup.time;
   a.steps = sim.steps();
   return a;
 }
-
-}  // namespace
-
-namespace {
 
 // The model's threads set for a scope, and restored after.
 class ThreadsFor {
@@ -213,12 +208,7 @@ AtlasReference atlasReference(const World& w, double k, AtlasScene scene, const 
       std::pow(2.0,
                std::max(0.0, std::ceil(std::log2(setup.interval * ref.wMax / setup.referenceHw))));
   const VisibleMotion visible(w.cubeResolution);
-  TrajectoryKey key{scene == AtlasScene::Falling ? "falling" : "free",
-                    k,
-                    w.cubeResolution,
-                    ref.dt,
-                    setup.interval,
-                    setup.time};
+  TrajectoryKey key{sceneName(scene), k, w.cubeResolution, ref.dt, setup.interval, setup.time};
   ref.samples = referenceFits(w, key, setup, visible);
   key.dt = 2.0 * ref.dt;
   const std::vector<Fit> check = referenceFits(w, key, setup, visible);
@@ -284,7 +274,7 @@ void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const Atla
       options.cvode.rtol = rtols[i];
       options.cvode.maxStepsPerCall = 100000000;
     }
-    const Attempt a = attempt(w, kind, dt, options, setup, visible, &ref);
+    const Attempt a = attempt(w, kind, dt, options, setup, visible, ref);
     ++tried;
     if (!a.finished && a.why == "over the run budget") {
       outcome = "budget";

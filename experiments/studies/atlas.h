@@ -41,6 +41,7 @@ struct AtlasSetup {
 // which touches nothing within the window: only rigid motion and what the spin stretches.
 enum class AtlasScene { Falling, Free };
 std::optional<AtlasScene> parseAtlasScene(const std::string& name);
+std::string sceneName(AtlasScene scene);  // as parseAtlasScene reads it
 std::string describe(AtlasScene scene);
 
 // The scene at stiffness k (c = 0.25 N*s/m), N^3 points of 1/512 kg (w_max does not depend on N).
