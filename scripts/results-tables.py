@@ -417,10 +417,15 @@ def experiments_runtime():
             f"VMs ({each}; each sidecar's `wall_time_s`, machine and date).")
     # The atlas-only runs (scripts/run-experiments.sh atlas), one or more per N: (N, the run's
     # k when N has several, minutes).
-    # A run whose reference had threads of its own (--atlas-reference-threads) says so.
+    # A run whose references are kept in a directory (--atlas-references; read from there when
+    # found, so its time may not include them) or computed on threads of their own says so.
     def threads(sidecar):
-        count = sidecar["parameters"]["atlas"].get("reference_threads", 0)
-        return count if count > 1 else 0
+        atlas = sidecar["parameters"]["atlas"]
+        where, count = atlas.get("reference_dir", ""), atlas.get("reference_threads", 0)
+        if not where:
+            return f" (its reference on {count} threads)" if count > 1 else ""
+        return (f" (its reference kept in `{where}`, read from there when found"
+                + (f", else computed on {count} threads" if count > 1 else "") + ")")
 
     extra = [(n, sidecar["parameters"]["atlas"]["k_N_per_m"] if len(sidecars) > 1 else None,
               sidecar["wall_time_s"] / 60, threads(sidecar))
@@ -434,10 +439,9 @@ def experiments_runtime():
             return f"N = {n} at k = {span}"
         text += (" The atlas at " + " and ".join(which(n, ks) for n, ks, _, _ in extra) +
                  " took " + " and ".join(
-                     f"{t:.0f} min" + (f" (its reference on {r} threads)" if r else "")
-                     for _, _, t, r in extra) +
-                 (", the timed runs" if any(r for *_, r in extra) else "") +
-                 ", each on one core of the same machine.")
+                     f"{t:.0f} min{r}" for _, _, t, r in extra) +
+                 (", the timed runs" if any(r for *_, r in extra) else ",") +
+                 " each on one core of the same machine.")
     free = sorted((n, sidecar["wall_time_s"], sidecar["parameters"]["jobs"])
                   for n, (_, sidecars) in atlas_sources(ATLAS_FREE).items()
                   for sidecar in sidecars)
