@@ -416,10 +416,10 @@ def experiments_runtime():
     text = (f"The committed results took {total / 60:.0f} minutes of wall time to make on 2-core "
             f"VMs ({each}; each sidecar's `wall_time_s`, machine and date).")
     # The atlas-only runs (scripts/run-experiments.sh atlas), one or more per N: (N, the run's
-    # k when N has several, minutes).
+    # k when N has several, minutes, a note on its references).
     # A run whose references are kept in a directory (--atlas-references; read from there when
     # found, so its time may not include them) or computed on threads of their own says so.
-    def threads(sidecar):
+    def reference_note(sidecar):
         atlas = sidecar["parameters"]["atlas"]
         where, count = atlas.get("reference_dir", ""), atlas.get("reference_threads", 0)
         if not where:
@@ -428,7 +428,7 @@ def experiments_runtime():
                 + (f", else computed on {count} threads" if count > 1 else "") + ")")
 
     extra = [(n, sidecar["parameters"]["atlas"]["k_N_per_m"] if len(sidecars) > 1 else None,
-              sidecar["wall_time_s"] / 60, threads(sidecar))
+              sidecar["wall_time_s"] / 60, reference_note(sidecar))
              for n, (_, sidecars) in sorted(atlas_sources().items()) for sidecar in sidecars
              if not sidecar["parameters"]["n"]]
     if extra:
