@@ -4,7 +4,7 @@
 #   jello.w, RK4 at the world's dt, shaded and wireframe (the simulation keeps up);
 #   cube16.w with cvode (the simulation lags far behind: the drawing must not);
 #   cube16.w with RK4 as the viewer runs it (its loops on one CPU fewer than there are:
-#   src/parallel.h, leaveOneCpuFree) and with JELLO_THREADS=2.
+#   src/base/parallel.h, leaveOneCpuFree) and with JELLO_THREADS=2.
 # Pinned to one core for the drawing's figure (`taskset -c 0,1` leaves the simulation thread
 # the other). Writes experiments/results/viewer_fps.json; `scripts/viewer-table.py --readme`
 # puts it in the README.   scripts/bench-viewer.sh [FRAMES]

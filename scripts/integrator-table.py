@@ -43,7 +43,7 @@ SIDECAR = os.path.join(ROOT, "experiments", "results", "integrators.json")
 # Google Benchmark's JSON of BM_ImplicitIntegratorStep (see --steps-json), and its README table.
 STEPS_JSON = os.path.join(ROOT, "experiments", "results", "implicit_steps.json")
 CROSSOVER_JSON = os.path.join(ROOT, "experiments", "results", "crossover.json")
-# BM_KeptFactorSolve (solvers/prefactored_cholesky.h), its own JSON.
+# BM_KeptFactorSolve (solvers/linalg/prefactored_cholesky.h), its own JSON.
 FACTOR_JSON = os.path.join(ROOT, "experiments", "results", "kept_factor.json")
 
 # Benchmark variants of one integrator (experiments/bench/benchmarks_implicit.cpp), as the tables

@@ -13,7 +13,7 @@ scripts/build.sh "$preset"
 # One test per core. GNU nproc honours OMP_NUM_THREADS and OMP_THREAD_LIMIT, so it is asked
 # without them (asked after the export below, it said 1 and ctest ran every test in turn).
 jobs=$(env -u OMP_NUM_THREADS -u OMP_THREAD_LIMIT nproc)
-# Single-threaded BLAS and CHOLMOD, as jello-sim runs them (solvers/solver_threads.h).
+# Single-threaded BLAS and CHOLMOD, as jello-sim runs them (solvers/linalg/solver_threads.h).
 export OMP_THREAD_LIMIT=${OMP_THREAD_LIMIT:-1} OPENBLAS_NUM_THREADS=${OPENBLAS_NUM_THREADS:-1}
 exclude=()
 [ "$preset" = asan ] && exclude=(--label-exclude "slow|soak|experiments")

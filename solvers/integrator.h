@@ -1,9 +1,9 @@
 // The one seam between physics and time stepping: an Integrator advances a State by h using
-// only the Model (forces, and later its Jacobians). makeIntegrator is the factory behind the
-// name registry (integrator_name.h), so any world can be stepped by any integrator.
+// only the Model (forces and Jacobians). The wings implement it (solvers/methods/,
+// solvers/cvode/); solvers/integrator_factory.h builds one from the integrator table
+// (src/world/integrator_name.h), so any world can be stepped by any integrator.
 #pragma once
 
-#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -11,9 +11,9 @@
 
 #include "solvers/solver_options.h"
 #include "solvers/step_result.h"
-#include "src/integrator_name.h"
 #include "src/model.h"
 #include "src/state.h"
+#include "src/world/integrator_name.h"
 
 namespace jello {
 
@@ -40,7 +40,5 @@ class Integrator {
   // history from step to step must start afresh at the next step.
   virtual void restart() {}
 };
-
-std::unique_ptr<Integrator> makeIntegrator(IntegratorKind kind, const SolverOptions& options = {});
 
 }  // namespace jello

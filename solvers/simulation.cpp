@@ -6,9 +6,10 @@
 #include <cstddef>
 #include <sstream>
 
-#include "src/assertions.h"
-#include "src/integrator_name.h"
-#include "src/parallel.h"
+#include "solvers/integrator_factory.h"
+#include "src/base/assertions.h"
+#include "src/base/parallel.h"
+#include "src/world/integrator_name.h"
 
 namespace jello {
 

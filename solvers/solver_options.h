@@ -1,7 +1,7 @@
 // Settings of the implicit integrators, as plain structs (README "Implicit solvers").
 #pragma once
 
-#include "solvers/linear_solver.h"
+#include "solvers/linalg/linear_solver.h"
 
 namespace jello {
 
@@ -13,7 +13,8 @@ struct ImplicitOptions {
   LinearSolverKind linearSolver = LinearSolverKind::Cg;
   PreconditionerKind preconditioner = PreconditionerKind::Jacobi;  // cg's
   bool matrixFree = true;  // cg: products through the spring kernels, not the sparse matrix
-  // The converged integrators (implicit, midpoint, newmark, bdf2; solvers/newton_integrators.h).
+  // The converged integrators (implicit, midpoint, newmark, bdf2;
+  // solvers/methods/newton_integrators.h).
   int newtonMaxIterations = 30;           // a step still unconverged then is counted, reported
   double newtonTolerance = 1e-8;          // relative residual that ends the iterations
   double newtonPositionTolerance = 1e-8;  // m: a full Newton update this small ends them too
@@ -24,9 +25,9 @@ struct ImplicitOptions {
   bool reuseFactor = true;
   double refactorRatio = 0.5;
   // Seed iterations: before Newton, up to this many iterations d <- d - P^-1 (h^2/gamma) r(d)
-  // with the projective matrix P = M + L(a c + b k) (solvers/spring_laplacian.h), factored once
-  // per step size; each costs a force evaluation and a back-substitution, no assembly. They stop
-  // at the first iterate in contact (P does not bound the penalty springs). 0: none.
+  // with the projective matrix P = M + L(a c + b k) (solvers/system/spring_laplacian.h), factored
+  // once per step size; each costs a force evaluation and a back-substitution, no assembly. They
+  // stop at the first iterate in contact (P does not bound the penalty springs). 0: none.
   int seedIterations = 0;
   // The seeds stop at this relative residual, from where Newton converges in one or two
   // iterations; at or below newtonTolerance they may converge the step themselves (with
@@ -79,7 +80,7 @@ struct CvodeOptions {
   bool krylov = false;
   bool clampCompression = true;
   double cgTolerance = 1e-6;
-  // The serial vectors' hot operations by our own vectorized loops (solvers/fast_nvector.h);
+  // The serial vectors' hot operations by our own vectorized loops (solvers/cvode/fast_nvector.h);
   // off: SUNDIALS' own, for the benchmark that measures the difference.
   bool fastVectors = true;
 

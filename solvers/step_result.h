@@ -8,7 +8,7 @@ namespace jello {
 struct [[nodiscard]] StepResult {
   bool ok = true;
   std::string message;  // why, when !ok
-  // Not a failure of the numerics: a stop was requested (src/interrupt.h) inside the step,
+  // Not a failure of the numerics: a stop was requested (src/base/interrupt.h) inside the step,
   // which left the state as it was before the step.
   bool interrupted = false;
   // Not a failure of the numerics either: a resource the step needs is missing (the

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "src/assertions.h"
+#include "src/base/assertions.h"
 
 namespace jello {
 
@@ -101,8 +101,9 @@ void Model::acceleration(const double* x, const double* v, double* a, PointRange
 
 void Model::evaluate(const double* x, const double* v, double* f, double scale,
                      PointRangeRef then) const {
-  // The springs in the two phases of src/parallel.h (one serial call below kParallelMinPoints),
-  // then on each thread's block the rest of the forces, the scaling and then().
+  // The springs in the two phases of src/base/parallel.h (one serial call below
+  // kParallelMinPoints), then on each thread's block the rest of the forces, the scaling and
+  // then().
   const std::ptrdiff_t n = n_;
   std::atomic<bool> walls{false};  // evaluated on some block
   runOverPointBlocks(

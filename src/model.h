@@ -12,13 +12,13 @@
 #include <optional>
 #include <vector>
 
-#include "src/contact.h"
-#include "src/force_field.h"
-#include "src/obstacles.h"
-#include "src/parallel.h"
-#include "src/spring_forces.h"
+#include "src/base/parallel.h"
+#include "src/effects/contact.h"
+#include "src/effects/force_field.h"
+#include "src/effects/obstacles.h"
+#include "src/effects/spring_forces.h"
 #include "src/state.h"
-#include "src/world.h"
+#include "src/world/world.h"
 
 namespace jello {
 
@@ -78,7 +78,7 @@ class Model {
   // The same, then then(lo, hi) on ranges of points whose acceleration is final, each point in
   // one range: a step's update of those points fused with the evaluation. From
   // kParallelMinPoints points up the work is split over threads by blocks of points
-  // (src/parallel.h, runOverPointBlocks): a thread computes its block's forces, contact and
+  // (src/base/parallel.h, runOverPointBlocks): a thread computes its block's forces, contact and
   // acceleration and runs then() on them, so what one stage writes stays in that core's cache
   // for the next (updates on one thread between threaded evaluations made a 32^3 RK4 step
   // little faster on two).
@@ -132,8 +132,8 @@ class Model {
   void externalForces(const double* x, Eigen::VectorXd& f) const;
   Energy energy(const State& s) const { return energy(s.x, s.v); }
 
-  // Adds every effect's Jacobian blocks at positions x (src/jacobian_blocks.h): the springs,
-  // and the walls, plane, sphere and field where the scene has them. The user force is
+  // Adds every effect's Jacobian blocks at positions x (src/effects/jacobian_blocks.h): the
+  // springs, and the walls, plane, sphere and field where the scene has them. The user force is
   // constant and adds nothing.
   void addJacobian(const double* x, JacobianBlocks& out) const;
 
@@ -158,7 +158,7 @@ class Model {
   void clearUserForce() { userForce_.reset(); }
   bool hasUserForce() const { return userForce_.has_value(); }
 
-  // How the model splits its points over threads (src/parallel.h): acceleration()'s then()
+  // How the model splits its points over threads (src/base/parallel.h): acceleration()'s then()
   // runs on these blocks, so a caller's pass over the same blocks finds its data in its core.
   PointBlocks pointBlocks() const {
     return splitPointBlocks(n_, springs_.reach(), springs_.threads());

@@ -1,6 +1,6 @@
 #include "src/state.h"
 
-#include "src/assertions.h"
+#include "src/base/assertions.h"
 
 namespace jello {
 

@@ -7,8 +7,8 @@
 
 #include <Eigen/Core>
 
-#include "src/vec3.h"
-#include "src/world.h"
+#include "src/base/vec3.h"
+#include "src/world/world.h"
 
 namespace jello {
 

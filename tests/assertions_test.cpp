@@ -1,14 +1,14 @@
 // The project's checks: JELLO_ASSERT and JELLO_VALIDATE abort with the condition where they are
 // on (debug and asan builds), evaluate nothing where they are off (release), and the checks
 // placed in the code fire on the errors they guard against.
-#include "src/assertions.h"
+#include "src/base/assertions.h"
 
 #include <gtest/gtest.h>
 
 #include <limits>
 
 #include "solvers/simulation.h"
-#include "src/scene_builder.h"
+#include "src/world/scene_builder.h"
 #include "tests/test_support.h"
 
 namespace jello {

@@ -14,7 +14,7 @@
 #include "experiments/studies/atlas.h"
 #include "experiments/studies/reference_file.h"
 #include "solvers/simulation.h"
-#include "src/parallel.h"
+#include "src/base/parallel.h"
 #include "tests/experiments_support.h"
 #include "tests/test_support.h"
 

@@ -5,11 +5,11 @@
 #include <cmath>
 #include <vector>
 
-#include "solvers/explicit_integrators.h"
-#include "solvers/linear_solver.h"
-#include "solvers/linearized_backward_euler.h"
-#include "solvers/newton_integrators.h"
-#include "src/scene_builder.h"
+#include "solvers/linalg/linear_solver.h"
+#include "solvers/methods/explicit_integrators.h"
+#include "solvers/methods/linearized_backward_euler.h"
+#include "solvers/methods/newton_integrators.h"
+#include "src/world/scene_builder.h"
 #include "tests/newton_test_support.h"
 #include "tests/test_support.h"
 

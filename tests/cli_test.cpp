@@ -13,10 +13,10 @@
 #include <regex>
 #include <sstream>
 
-#include "src/atomic_file.h"
-#include "src/scene_builder.h"
-#include "src/world_reader.h"
-#include "src/world_writer.h"
+#include "src/base/atomic_file.h"
+#include "src/world/scene_builder.h"
+#include "src/world/world_reader.h"
+#include "src/world/world_writer.h"
 #include "tests/test_support.h"
 
 namespace jello {

@@ -1,12 +1,12 @@
 // Penalty contact: direction, magnitude, and consistency with its energy.
-#include "src/contact.h"
+#include "src/effects/contact.h"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
 #include <cmath>
 
-#include "src/scene_builder.h"
+#include "src/world/scene_builder.h"
 
 namespace jello {
 namespace {

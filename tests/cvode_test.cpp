@@ -3,10 +3,10 @@
 
 #include <map>
 
-#include "solvers/cvode_integrator.h"
-#include "solvers/explicit_integrators.h"
+#include "solvers/cvode/cvode_integrator.h"
+#include "solvers/methods/explicit_integrators.h"
 #include "solvers/simulation.h"
-#include "src/scene_builder.h"
+#include "src/world/scene_builder.h"
 #include "tests/test_support.h"
 
 namespace jello {

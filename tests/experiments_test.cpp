@@ -23,10 +23,10 @@
 #include "experiments/studies/ranks.h"
 #include "experiments/studies/run_context.h"
 #include "experiments/studies/stability_analysis.h"
-#include "solvers/jacobian.h"
 #include "solvers/simulation.h"
-#include "src/parallel.h"
-#include "src/scene_builder.h"
+#include "solvers/system/jacobian.h"
+#include "src/base/parallel.h"
+#include "src/world/scene_builder.h"
 #include "tests/experiments_support.h"
 #include "tests/test_support.h"
 

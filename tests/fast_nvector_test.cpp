@@ -1,7 +1,7 @@
-// installFastOperations (solvers/fast_nvector.h): every replaced operation gives what SUNDIALS'
-// own serial operation gives (to round-off: sums may add in another order), clones inherit the
-// replacements, and vectors of another kind are left alone.
-#include "solvers/fast_nvector.h"
+// installFastOperations (solvers/cvode/fast_nvector.h): every replaced operation gives what
+// SUNDIALS' own serial operation gives (to round-off: sums may add in another order), clones
+// inherit the replacements, and vectors of another kind are left alone.
+#include "solvers/cvode/fast_nvector.h"
 
 #include <gtest/gtest.h>
 #include <nvector/nvector_serial.h>
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "solvers/sundials_handles.h"
+#include "solvers/cvode/sundials_handles.h"
 
 namespace jello {
 namespace {

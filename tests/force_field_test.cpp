@@ -1,12 +1,12 @@
 // Trilinear interpolation of the force field.
-#include "src/force_field.h"
+#include "src/effects/force_field.h"
 
 #include <gtest/gtest.h>
 
 #include <limits>
 #include <random>
 
-#include "src/scene_builder.h"
+#include "src/world/scene_builder.h"
 #include "tests/test_support.h"
 
 namespace jello {

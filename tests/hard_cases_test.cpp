@@ -9,7 +9,7 @@
 #include <cstdio>
 
 #include "solvers/simulation.h"
-#include "src/scene_builder.h"
+#include "src/world/scene_builder.h"
 
 namespace jello {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "solvers/explicit_integrators.h"
+#include "solvers/methods/explicit_integrators.h"
 #include "tests/test_support.h"
 
 namespace jello {

@@ -1,5 +1,5 @@
 // Assembled Jacobians against central differences of the forces, effect by effect.
-#include "solvers/jacobian.h"
+#include "solvers/system/jacobian.h"
 
 #include <gtest/gtest.h>
 
@@ -7,10 +7,10 @@
 #include <random>
 #include <utility>
 
-#include "solvers/implicit_system.h"
-#include "solvers/system_operator.h"
-#include "src/parallel.h"
-#include "src/scene_builder.h"
+#include "solvers/system/implicit_system.h"
+#include "solvers/system/system_operator.h"
+#include "src/base/parallel.h"
+#include "src/world/scene_builder.h"
 #include "tests/test_support.h"
 
 namespace jello {

@@ -4,7 +4,7 @@
 #include <set>
 #include <utility>
 
-#include "src/spring_forces.h"
+#include "src/effects/spring_forces.h"
 
 namespace jello {
 namespace {

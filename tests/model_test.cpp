@@ -13,8 +13,8 @@
 #include <thread>
 #include <vector>
 
-#include "src/parallel.h"
-#include "src/scene_builder.h"
+#include "src/base/parallel.h"
+#include "src/world/scene_builder.h"
 #include "tests/test_support.h"
 
 namespace jello {

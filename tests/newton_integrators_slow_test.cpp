@@ -8,11 +8,12 @@
 #include <cstdio>
 #include <memory>
 
-#include "solvers/explicit_integrators.h"
-#include "solvers/linearized_backward_euler.h"
-#include "solvers/newton_integrators.h"
+#include "solvers/integrator_factory.h"
+#include "solvers/methods/explicit_integrators.h"
+#include "solvers/methods/linearized_backward_euler.h"
+#include "solvers/methods/newton_integrators.h"
 #include "solvers/simulation.h"
-#include "src/scene_builder.h"
+#include "src/world/scene_builder.h"
 #include "tests/newton_test_support.h"
 #include "tests/test_support.h"
 
@@ -88,8 +89,8 @@ TEST(NewtonIntegrators, KeepTheAngularMomentumOfASpinningStretchedCube) {
     // loses 2.5% in its first step.
     EXPECT_NEAR(angularMomentumKept(IntegratorKind::Midpoint, k, 1e-13), 1.0, 1e-9);
     // BDF2's backward-Euler start costs 2.5%, of which it gives some back: measured 98.74% at
-    // both k, short of the 99% asked (solvers/newton_integrators.h: what second-order starts
-    // do instead). Asserted to the measured figure, so a loss that grows fails.
+    // both k, short of the 99% asked (solvers/methods/newton_integrators.h: what second-order
+    // starts do instead). Asserted to the measured figure, so a loss that grows fails.
     const double bdf2 = angularMomentumKept(IntegratorKind::Bdf2, k);
     std::printf("at k = %g: bdf2 keeps %.5f of the angular momentum\n", k, bdf2);
     EXPECT_GE(bdf2, 0.987);

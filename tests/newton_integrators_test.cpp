@@ -3,7 +3,7 @@
 // residual), the Newton matrix is the residual's derivative, Newton finishes at rest, the orders
 // of convergence, midpoint's energy, and the angular momentum of a spinning stretched cube,
 // which the linearized step (implicit-linear) loses.
-#include "solvers/newton_integrators.h"
+#include "solvers/methods/newton_integrators.h"
 
 #include <gtest/gtest.h>
 
@@ -12,10 +12,10 @@
 #include <cstdio>
 #include <memory>
 
-#include "solvers/explicit_integrators.h"
-#include "solvers/linearized_backward_euler.h"
+#include "solvers/methods/explicit_integrators.h"
+#include "solvers/methods/linearized_backward_euler.h"
 #include "solvers/simulation.h"
-#include "src/scene_builder.h"
+#include "src/world/scene_builder.h"
 #include "tests/newton_test_support.h"
 #include "tests/test_support.h"
 

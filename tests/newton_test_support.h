@@ -8,8 +8,8 @@
 #include <cmath>
 #include <memory>
 
-#include "solvers/newton_integrators.h"
-#include "src/scene_builder.h"
+#include "solvers/methods/newton_integrators.h"
+#include "src/world/scene_builder.h"
 #include "tests/test_support.h"
 
 namespace jello::test {

@@ -1,7 +1,7 @@
 // The cone and the spiral ramp: forces against finite differences of their energy, Jacobians
 // against finite differences of the forces, the world file's extensions, and a cube that comes to
 // rest on each instead of falling through.
-#include "src/obstacles.h"
+#include "src/effects/obstacles.h"
 
 #include <gtest/gtest.h>
 
@@ -10,10 +10,10 @@
 #include <functional>
 #include <random>
 
-#include "solvers/jacobian.h"
 #include "solvers/simulation.h"
-#include "src/world_reader.h"
-#include "src/world_writer.h"
+#include "solvers/system/jacobian.h"
+#include "src/world/world_reader.h"
+#include "src/world/world_writer.h"
 #include "tests/test_support.h"
 
 namespace jello {

@@ -1,7 +1,7 @@
-// PrefactoredCholesky (solvers/prefactored_cholesky.h): its own substitutions over CHOLMOD's
+// PrefactoredCholesky (solvers/linalg/prefactored_cholesky.h): its own substitutions over CHOLMOD's
 // factor solve the system, for one to three right-hand sides, after refactoring with new
 // values, and refuse a matrix that is not positive definite.
-#include "solvers/prefactored_cholesky.h"
+#include "solvers/linalg/prefactored_cholesky.h"
 
 #include <gtest/gtest.h>
 
@@ -9,9 +9,9 @@
 #include <algorithm>
 #include <vector>
 
-#include "solvers/dense_tail.h"
+#include "solvers/linalg/dense_tail.h"
 #include "src/model.h"
-#include "src/scene_builder.h"
+#include "src/world/scene_builder.h"
 #include "tests/test_support.h"
 
 namespace jello {
@@ -152,8 +152,8 @@ TEST_P(PrefactoredCholeskyBothWays, UpdatesAndDowndatesTheDiagonal) {
   EXPECT_LT((Eigen::MatrixXd(A) * X - B).norm(), 10 * tolerance() * B.norm() * dense.norm());
 }
 
-// The dense tail (solvers/dense_tail.h) on its own: a lower triangle of 21 columns (two whole
-// panels and a padded one) solves L y = b and L' y = b like Eigen's triangular solves, one to
+// The dense tail (solvers/linalg/dense_tail.h) on its own: a lower triangle of 21 columns (two
+// whole panels and a padded one) solves L y = b and L' y = b like Eigen's triangular solves, one to
 // three right-hand sides at once.
 TEST(DenseTail, SolvesBothTrianglesLikeEigen) {
   const int w = 21;
@@ -181,8 +181,8 @@ TEST(DenseTail, SolvesBothTrianglesLikeEigen) {
 }
 
 // The single-precision factor takes diagonal changes as a low-rank correction solved through
-// it (solvers/diagonal_correction.h): as close to a factorization of the changed matrix as the
-// factor itself is to the original, over rounds that add points, change them again and take
+// it (solvers/linalg/diagonal_correction.h): as close to a factorization of the changed matrix as
+// the factor itself is to the original, over rounds that add points, change them again and take
 // some back out (the correction then shrinks), and cleared by the next factorization.
 TEST(PrefactoredCholesky, SinglePrecisionFactorsSolveDiagonalChangesThroughACorrection) {
   const Model model(resampleCube(test::loadWorld("jello.w"), 6));

@@ -1,15 +1,16 @@
-// projective (solvers/projective_integrator.h): its iterations converge to the backward-Euler
-// step, it keeps what backward Euler keeps, its factor is reused, and contact changes refactor.
+// projective (solvers/methods/projective_integrator.h): its iterations converge to the
+// backward-Euler step, it keeps what backward Euler keeps, its factor is reused, and contact
+// changes refactor.
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <map>
 #include <vector>
 
-#include "solvers/newton_integrators.h"
-#include "solvers/projective_integrator.h"
+#include "solvers/methods/newton_integrators.h"
+#include "solvers/methods/projective_integrator.h"
 #include "solvers/simulation.h"
-#include "src/scene_builder.h"
+#include "src/world/scene_builder.h"
 #include "tests/newton_test_support.h"
 #include "tests/test_support.h"
 
@@ -243,9 +244,9 @@ TEST(Projective, FactorsOncePerSceneAndStepSizeAndAgainOnContactChanges) {
 }
 
 // At 10^3 points and up the factor is solved in single precision and contact changes become a
-// low-rank correction through it (solvers/diagonal_correction.h) instead of CHOLMOD's updates:
-// the same steps as factoring afresh at every change, to the factor's precision, and the floor
-// still holds the cube.
+// low-rank correction through it (solvers/linalg/diagonal_correction.h) instead of CHOLMOD's
+// updates: the same steps as factoring afresh at every change, to the factor's precision, and the
+// floor still holds the cube.
 TEST(Projective, LargeFactorsTakeContactChangesAsACorrectionWithTheSameSteps) {
   const World w = resampleCube(test::loadWorld("jello.w"), 12);
   const Model model(w);

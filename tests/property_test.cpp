@@ -10,9 +10,9 @@
 #include <sstream>
 
 #include "solvers/simulation.h"
-#include "src/scene_builder.h"
-#include "src/world_reader.h"
-#include "src/world_writer.h"
+#include "src/world/scene_builder.h"
+#include "src/world/world_reader.h"
+#include "src/world/world_writer.h"
 #include "tests/test_support.h"
 
 namespace jello {

@@ -11,8 +11,8 @@
 #include <cmath>
 #include <thread>
 
-#include "src/scene_builder.h"
-#include "src/world_reader.h"
+#include "src/world/scene_builder.h"
+#include "src/world/world_reader.h"
 #include "tests/test_support.h"
 #include "viewer/runner_group.h"
 #include "viewer/viewer_state.h"

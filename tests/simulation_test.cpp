@@ -7,10 +7,11 @@
 #include <limits>
 #include <string>
 
-#include "src/parallel.h"
-#include "src/scene_builder.h"
-#include "src/world_reader.h"
-#include "src/world_writer.h"
+#include "solvers/integrator_factory.h"
+#include "src/base/parallel.h"
+#include "src/world/scene_builder.h"
+#include "src/world/world_reader.h"
+#include "src/world/world_writer.h"
 #include "tests/test_support.h"
 
 namespace jello {
@@ -223,8 +224,8 @@ TEST(Simulation, EveryReferenceWorldRunsATenthOfASecondWithItsOwnSettings) {
   for (int i = 0; i < 1000; ++i) ASSERT_TRUE(skewed.step().ok);
 }
 
-// The one table of integrators (src/integrator_name.h): every row parses from its name and its
-// file spelling, has a summary, and the factory builds its class.
+// The one table of integrators (src/world/integrator_name.h): every row parses from its name and
+// its file spelling, has a summary, and the factory builds its class.
 TEST(IntegratorTable, EveryRowParsesBuildsAndNamesItself) {
   ASSERT_FALSE(allIntegrators().empty());
   for (IntegratorKind kind : allIntegrators()) {

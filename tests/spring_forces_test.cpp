@@ -5,10 +5,10 @@
 #include <random>
 #include <string>
 
-#include "solvers/explicit_integrators.h"
+#include "solvers/methods/explicit_integrators.h"
+#include "src/base/parallel.h"
 #include "src/model.h"
-#include "src/parallel.h"
-#include "src/scene_builder.h"
+#include "src/world/scene_builder.h"
 #include "tests/test_support.h"
 
 namespace jello {
@@ -112,7 +112,7 @@ TEST(SpringForces, RK4OnTwoThreadsKeepsAFreeSpinningCubesMomentaAndEnergy) {
   EXPECT_GT(model.energy(s).spring, 1e-3 * e0);  // deformed: the springs work
 }
 
-// Both cores (src/parallel.h): the threaded evaluation splits the points into one block per
+// Both cores (src/base/parallel.h): the threaded evaluation splits the points into one block per
 // thread, each run in two halves; it equals the serial sum to round-off, for 2 and 3 threads, at
 // 16^3 and 32^3 on a deformed moving cube, as do the springs' energy and a whole RK4 step. Below
 // kParallelMinPoints (16^3: at 8^3) each is the serial result, bit for bit.

@@ -8,7 +8,7 @@
 #include <random>
 #include <sstream>
 
-#include "src/world_reader.h"
+#include "src/world/world_reader.h"
 
 namespace jello::test {
 

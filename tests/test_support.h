@@ -6,7 +6,7 @@
 
 #include "src/model.h"
 #include "src/state.h"
-#include "src/world.h"
+#include "src/world/world.h"
 
 namespace jello::test {
 

@@ -9,7 +9,7 @@
 #include <cstdlib>
 
 #include "src/state.h"
-#include "src/world_writer.h"
+#include "src/world/world_writer.h"
 #include "tests/test_support.h"
 #include "viewer/camera.h"
 #include "viewer/image_writer.h"

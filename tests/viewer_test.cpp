@@ -6,7 +6,7 @@
 #include <fstream>
 #include <random>
 
-#include "src/world_writer.h"
+#include "src/world/world_writer.h"
 #include "tests/test_support.h"
 #include "viewer/box_geometry.h"
 #include "viewer/camera.h"

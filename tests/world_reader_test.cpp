@@ -1,5 +1,5 @@
 // The reader against the six reference worlds and every class of bad input.
-#include "src/world_reader.h"
+#include "src/world/world_reader.h"
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -14,8 +14,8 @@
 #include <thread>
 #include <vector>
 
-#include "src/scene_builder.h"
-#include "src/world_writer.h"
+#include "src/world/scene_builder.h"
+#include "src/world/world_writer.h"
 #include "tests/test_support.h"
 
 namespace jello {

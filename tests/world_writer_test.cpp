@@ -1,5 +1,5 @@
 // The writer: exact round trips, the original creator's format, extensions, atomic replace.
-#include "src/world_writer.h"
+#include "src/world/world_writer.h"
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -17,9 +17,9 @@
 #include <string>
 #include <thread>
 
-#include "src/atomic_file.h"
-#include "src/scene_builder.h"
-#include "src/world_reader.h"
+#include "src/base/atomic_file.h"
+#include "src/world/scene_builder.h"
+#include "src/world/world_reader.h"
 #include "tests/test_support.h"
 
 namespace jello {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "src/contact.h"
+#include "src/effects/contact.h"
 
 namespace jello::viewer {
 

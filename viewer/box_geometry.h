@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "src/world.h"
+#include "src/world/world.h"
 
 namespace jello::viewer {
 

@@ -11,7 +11,7 @@
 #include <numbers>
 #include <optional>
 
-#include "src/vec3.h"
+#include "src/base/vec3.h"
 
 namespace jello::viewer {
 

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "src/atomic_file.h"
+#include "src/base/atomic_file.h"
 
 // stb is header-only: its implementation lives in this one file.
 #define STB_IMAGE_WRITE_IMPLEMENTATION

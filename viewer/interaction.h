@@ -14,8 +14,8 @@
 #include <span>
 #include <vector>
 
-#include "src/lattice.h"
 #include "src/state.h"
+#include "src/world/lattice.h"
 #include "viewer/camera.h"
 #include "viewer/surface.h"
 

@@ -10,11 +10,11 @@
 #include <regex>
 #include <sstream>
 
-#include "solvers/solver_threads.h"
-#include "src/finite_options.h"
-#include "src/out_of_memory.h"
-#include "src/parallel.h"
-#include "src/world_reader.h"
+#include "solvers/linalg/solver_threads.h"
+#include "src/base/finite_options.h"
+#include "src/base/out_of_memory.h"
+#include "src/base/parallel.h"
+#include "src/world/world_reader.h"
 #include "viewer/texture.h"
 #include "viewer/viewer_app.h"
 #include "viewer/viewer_state.h"
@@ -35,7 +35,7 @@ std::filesystem::path defaultWorld() {
 int main(int argc, char** argv) {
   jello::exitCleanlyWhenOutOfMemory("jello");
   jello::applySolverThreadSettings(argv);
-  jello::leaveOneCpuFree();  // the drawing thread's (src/parallel.h)
+  jello::leaveOneCpuFree();  // the drawing thread's (src/base/parallel.h)
   jello::viewer::ViewerOptions opt;
   std::string world = defaultWorld().string(), integrator, size = "640x480";
   CLI::App app{"jello: the interactive jello cube (OpenGL/GLUT viewer)"};

@@ -11,7 +11,7 @@
 #include <GL/freeglut.h>
 #include <GL/gl.h>
 
-#include "src/contact.h"
+#include "src/effects/contact.h"
 #include "viewer/overlay.h"
 
 namespace jello::viewer {

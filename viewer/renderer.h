@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "src/state.h"
-#include "src/world.h"
+#include "src/world/world.h"
 #include "viewer/box_geometry.h"
 #include "viewer/camera.h"
 #include "viewer/image_writer.h"

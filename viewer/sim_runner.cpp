@@ -5,7 +5,7 @@
 #include <cmath>
 #include <csignal>
 
-#include "src/interrupt.h"
+#include "src/base/interrupt.h"
 
 namespace jello::viewer {
 

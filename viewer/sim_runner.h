@@ -2,7 +2,7 @@
 // it on its own thread; the render thread only posts commands (applied between steps) and copies
 // the latest published Frame, so drawing, keys and the mouse never wait for a step, however
 // long one takes. Commands that change the scene (reload, integrator, time step, quit) also cut
-// a long step short (src/interrupt.h): the step is retried afterwards from its start.
+// a long step short (src/base/interrupt.h): the step is retried afterwards from its start.
 //
 // Pacing: by default simulated time follows the wall clock times a playback speed. When the
 // simulation cannot keep up, it runs as fast as it can and at most kMaxBacklog wall seconds of

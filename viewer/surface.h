@@ -7,9 +7,9 @@
 #include <array>
 #include <vector>
 
-#include "src/lattice.h"
-#include "src/spring_forces.h"
+#include "src/effects/spring_forces.h"
 #include "src/state.h"
+#include "src/world/lattice.h"
 
 namespace jello::viewer {
 

@@ -8,8 +8,8 @@
 #include <optional>
 #include <vector>
 
-#include "src/integrator_name.h"
-#include "src/world.h"
+#include "src/world/integrator_name.h"
+#include "src/world/world.h"
 #include "viewer/camera.h"
 #include "viewer/viewer_session.h"
 

@@ -1,6 +1,6 @@
 #include "viewer/viewer_session.h"
 
-#include "src/world_writer.h"
+#include "src/world/world_writer.h"
 #include "viewer/viewer_state.h"
 
 namespace jello::viewer {

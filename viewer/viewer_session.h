@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "solvers/simulation.h"
-#include "src/world_reader.h"
+#include "src/world/world_reader.h"
 #include "viewer/box_geometry.h"
 #include "viewer/interaction.h"
 #include "viewer/surface.h"

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "src/integrator_name.h"
+#include "src/world/integrator_name.h"
 #include "viewer/camera.h"
 
 namespace jello::viewer {

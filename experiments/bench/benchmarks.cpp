@@ -12,13 +12,13 @@
 #include <memory>
 #include <string>
 
-#include "solvers/jacobian.h"
+#include "solvers/linalg/solver_threads.h"
 #include "solvers/simulation.h"
-#include "solvers/solver_threads.h"
-#include "solvers/system_operator.h"
-#include "src/parallel.h"
-#include "src/scene_builder.h"
-#include "src/world_reader.h"
+#include "solvers/system/jacobian.h"
+#include "solvers/system/system_operator.h"
+#include "src/base/parallel.h"
+#include "src/world/scene_builder.h"
+#include "src/world/world_reader.h"
 
 namespace {
 
@@ -64,7 +64,7 @@ BENCHMARK_CAPTURE(BM_Step, rk4, jello::IntegratorKind::RK4)->Arg(8)->Arg(16)->Ar
 BENCHMARK_CAPTURE(BM_Step, euler, jello::IntegratorKind::Euler)->Arg(8);
 BENCHMARK_CAPTURE(BM_Step, symplectic, jello::IntegratorKind::Symplectic)->Arg(8);
 
-// Both cores (src/parallel.h): the spring forces, a whole RK4 step and the implicit solvers'
+// Both cores (src/base/parallel.h): the spring forces, a whole RK4 step and the implicit solvers'
 // matrix-free product (backward Euler's matrix at dt = 0.01) at N^3 with the given number of
 // threads, 1 (serial) against 2, in one run. Run without taskset.
 enum class ThreadedWork { Springs, Rk4Step, Product };
@@ -120,7 +120,7 @@ BENCHMARK_CAPTURE(BM_Threads, product, ThreadedWork::Product)
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Single-threaded BLAS and CHOLMOD (see solvers/solver_threads.h).
+  // Single-threaded BLAS and CHOLMOD (see solvers/linalg/solver_threads.h).
   jello::applySolverThreadSettings(argv);
   benchmark::AddCustomContext("blas", jello::loadedBlas());
   benchmark::AddCustomContext("OPENBLAS_NUM_THREADS", std::getenv("OPENBLAS_NUM_THREADS"));

@@ -30,15 +30,15 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include "solvers/jacobian.h"
-#include "solvers/linear_solver.h"
-#include "solvers/newton_integrators.h"
-#include "solvers/prefactored_cholesky.h"
+#include "solvers/linalg/linear_solver.h"
+#include "solvers/linalg/prefactored_cholesky.h"
+#include "solvers/methods/newton_integrators.h"
 #include "solvers/simulation.h"
-#include "solvers/spring_laplacian.h"
-#include "solvers/system_operator.h"
-#include "src/scene_builder.h"
-#include "src/world_reader.h"
+#include "solvers/system/jacobian.h"
+#include "solvers/system/spring_laplacian.h"
+#include "solvers/system/system_operator.h"
+#include "src/world/scene_builder.h"
+#include "src/world/world_reader.h"
 
 namespace {
 

@@ -10,10 +10,10 @@
 #include "experiments/studies/stability_analysis.h"
 #include "experiments/studies/trajectory_run.h"
 #include "solvers/simulation.h"
-#include "src/integrator_name.h"
-#include "src/lattice.h"
-#include "src/parallel.h"
-#include "src/scene_builder.h"
+#include "src/base/parallel.h"
+#include "src/world/integrator_name.h"
+#include "src/world/lattice.h"
+#include "src/world/scene_builder.h"
 
 namespace jello::experiments {
 

@@ -17,7 +17,7 @@
 #include "experiments/studies/csv_table.h"
 #include "solvers/integrator.h"
 #include "src/state.h"
-#include "src/world.h"
+#include "src/world/world.h"
 
 namespace jello::experiments {
 

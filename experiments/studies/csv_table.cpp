@@ -5,7 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "src/atomic_file.h"
+#include "src/base/atomic_file.h"
 
 namespace jello::experiments {
 

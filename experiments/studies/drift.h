@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "experiments/studies/csv_table.h"
-#include "src/integrator_name.h"
-#include "src/world.h"
+#include "src/world/integrator_name.h"
+#include "src/world/world.h"
 
 namespace jello::experiments {
 

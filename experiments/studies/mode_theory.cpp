@@ -4,10 +4,10 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "solvers/jacobian.h"
-#include "src/lattice.h"
+#include "solvers/system/jacobian.h"
 #include "src/model.h"
 #include "src/state.h"
+#include "src/world/lattice.h"
 
 namespace jello::experiments {
 

@@ -15,8 +15,8 @@
 
 #include <Eigen/Core>
 
-#include "src/integrator_name.h"
-#include "src/world.h"
+#include "src/world/integrator_name.h"
+#include "src/world/world.h"
 
 namespace jello::experiments {
 

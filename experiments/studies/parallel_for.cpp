@@ -11,7 +11,7 @@
 
 #include "experiments/common/progress.h"
 #include "experiments/studies/csv_table.h"
-#include "src/parallel.h"
+#include "src/base/parallel.h"
 
 namespace jello::experiments {
 

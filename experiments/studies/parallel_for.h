@@ -13,7 +13,7 @@ namespace jello::experiments {
 // TaskScope(i) (csv_table.h), so the rows it adds are ordered by i. Exceptions propagate after
 // all threads stop. With jobs > 1 the model's loops stay on their task's thread meanwhile
 // (setParallelThreads(1), restored after): every job holds a CPU, and a loop split over threads
-// would wait for a part whose CPU another job holds (src/parallel.h, leaveOneCpuFree).
+// would wait for a part whose CPU another job holds (src/base/parallel.h, leaveOneCpuFree).
 void parallelFor(const std::vector<int>& tasks, int jobs, const std::string& label, bool progress,
                  const std::function<void(int)>& task);
 // The same for i in [0, count).

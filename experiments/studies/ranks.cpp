@@ -7,7 +7,7 @@
 #include <thread>
 
 #include "experiments/studies/parallel_for.h"
-#include "src/parallel.h"
+#include "src/base/parallel.h"
 
 #ifdef JELLO_HAVE_MPI
 #include <mpi.h>

@@ -12,11 +12,11 @@
 #include <fstream>
 #include <thread>
 
-#include "solvers/solver_threads.h"
-#include "src/atomic_file.h"
+#include "solvers/linalg/solver_threads.h"
+#include "src/base/atomic_file.h"
 #include "src/model.h"
-#include "src/scene_builder.h"
 #include "src/state.h"
+#include "src/world/scene_builder.h"
 
 namespace jello::experiments {
 

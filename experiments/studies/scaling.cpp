@@ -20,11 +20,11 @@
 #include "experiments/studies/ranks.h"
 #include "experiments/studies/run_context.h"
 #include "experiments/studies/stability_analysis.h"
+#include "solvers/linalg/solver_threads.h"
 #include "solvers/simulation.h"
-#include "solvers/solver_threads.h"
-#include "src/finite_options.h"
-#include "src/out_of_memory.h"
-#include "src/scene_builder.h"
+#include "src/base/finite_options.h"
+#include "src/base/out_of_memory.h"
+#include "src/world/scene_builder.h"
 
 namespace {
 

@@ -6,11 +6,11 @@
 #include <cstdint>
 #include <stdexcept>
 
-#include "solvers/jacobian.h"
 #include "solvers/simulation.h"
-#include "src/contact.h"
-#include "src/integrator_name.h"
-#include "src/scene_builder.h"
+#include "solvers/system/jacobian.h"
+#include "src/effects/contact.h"
+#include "src/world/integrator_name.h"
+#include "src/world/scene_builder.h"
 
 namespace jello::experiments {
 

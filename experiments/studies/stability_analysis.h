@@ -18,15 +18,15 @@
 #include <string>
 #include <string_view>
 
-#include "solvers/modes.h"
+#include "experiments/common/modes.h"
 #include "solvers/solver_options.h"
-#include "src/integrator_name.h"
 #include "src/model.h"
-#include "src/world.h"
+#include "src/world/integrator_name.h"
+#include "src/world/world.h"
 
 namespace jello::experiments {
 
-// maxAngularFrequency (solvers/modes.h), as the experiments call it.
+// maxAngularFrequency (experiments/common/modes.h), as the experiments call it.
 using jello::maxAngularFrequency;
 
 // The largest h at which `kind` is stable on every mode up to wMax with damping ratio

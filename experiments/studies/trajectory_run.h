@@ -9,7 +9,7 @@
 #include "solvers/integrator.h"
 #include "src/model.h"
 #include "src/state.h"
-#include "src/world.h"
+#include "src/world/world.h"
 
 namespace jello::experiments {
 

@@ -10,12 +10,12 @@
 #include <vector>
 
 #include "experiments/common/signal_handler.h"
-#include "src/atomic_file.h"
-#include "src/finite_options.h"
-#include "src/out_of_memory.h"
-#include "src/scene_builder.h"
-#include "src/world_reader.h"
-#include "src/world_writer.h"
+#include "src/base/atomic_file.h"
+#include "src/base/finite_options.h"
+#include "src/base/out_of_memory.h"
+#include "src/world/scene_builder.h"
+#include "src/world/world_reader.h"
+#include "src/world/world_writer.h"
 
 namespace {
 

@@ -16,20 +16,20 @@
 #include <utility>
 #include <vector>
 
+#include "experiments/common/modes.h"
 #include "experiments/common/progress.h"
 #include "experiments/common/signal_handler.h"
 #include "experiments/tools/output_check.h"
 #include "experiments/tools/solver_flags.h"
-#include "solvers/modes.h"
+#include "solvers/linalg/solver_threads.h"
 #include "solvers/simulation.h"
-#include "solvers/solver_threads.h"
-#include "src/atomic_file.h"
-#include "src/finite_options.h"
-#include "src/interrupt.h"
-#include "src/out_of_memory.h"
-#include "src/scene_builder.h"
-#include "src/world_reader.h"
-#include "src/world_writer.h"
+#include "src/base/atomic_file.h"
+#include "src/base/finite_options.h"
+#include "src/base/interrupt.h"
+#include "src/base/out_of_memory.h"
+#include "src/world/scene_builder.h"
+#include "src/world/world_reader.h"
+#include "src/world/world_writer.h"
 
 namespace {
 
@@ -44,7 +44,7 @@ volatile std::sig_atomic_t interruptSignal = 0;
 
 extern "C" void onInterrupt(int signo) {
   interruptSignal = signo;
-  jello::requestInterrupt(signo);  // polled inside long steps too (src/interrupt.h)
+  jello::requestInterrupt(signo);  // polled inside long steps too (src/base/interrupt.h)
 }
 
 struct Options {

@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-#include "src/atomic_file.h"
+#include "src/base/atomic_file.h"
 
 namespace jello {
 

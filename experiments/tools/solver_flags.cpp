@@ -1,7 +1,7 @@
 #include "experiments/tools/solver_flags.h"
 
-#include "solvers/linear_solver.h"
-#include "src/finite_options.h"
+#include "solvers/linalg/linear_solver.h"
+#include "src/base/finite_options.h"
 
 namespace jello {
 

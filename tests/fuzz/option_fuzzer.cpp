@@ -1,5 +1,5 @@
 // libFuzzer target for the command-line number validators every program shares
-// (src/finite_options.h): CLI11 parses the input, split at newlines into arguments, against
+// (src/base/finite_options.h): CLI11 parses the input, split at newlines into arguments, against
 // options of each kind the programs use. Contract: every value accepted is finite and inside
 // its range; anything else is a CLI::ParseError (exit 2 in the programs), never a crash.
 #include <CLI/CLI.hpp>
@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "src/finite_options.h"
+#include "src/base/finite_options.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::vector<std::string> args;

@@ -10,7 +10,7 @@
 
 #include "src/model.h"
 #include "src/state.h"
-#include "src/world_reader.h"
+#include "src/world/world_reader.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   // Small limits keep each input's allocations small; the limits themselves are tested.

@@ -21,7 +21,7 @@
 #include "solvers/solver_options.h"
 #include "src/model.h"
 #include "src/state.h"
-#include "src/world.h"
+#include "src/world/world.h"
 
 namespace py = pybind11;
 

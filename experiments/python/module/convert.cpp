@@ -2,7 +2,7 @@
 #include <optional>
 
 #include "experiments/python/module/bindings.h"
-#include "src/world_reader.h"
+#include "src/world/world_reader.h"
 
 namespace jello::python {
 

@@ -10,7 +10,7 @@
 
 #include "experiments/python/module/bindings.h"
 #include "experiments/studies/stability_analysis.h"
-#include "solvers/solver_threads.h"
+#include "solvers/linalg/solver_threads.h"
 
 namespace py = pybind11;
 using namespace py::literals;

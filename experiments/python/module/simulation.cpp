@@ -7,7 +7,7 @@
 #include <utility>
 
 #include "experiments/python/module/bindings.h"
-#include "solvers/jacobian.h"
+#include "solvers/system/jacobian.h"
 
 namespace jello::python {
 

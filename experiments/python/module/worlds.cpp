@@ -4,9 +4,9 @@
 #include <sstream>
 
 #include "experiments/python/module/bindings.h"
-#include "src/scene_builder.h"
-#include "src/world_reader.h"
-#include "src/world_writer.h"
+#include "src/world/scene_builder.h"
+#include "src/world/world_reader.h"
+#include "src/world/world_writer.h"
 
 namespace jello::python {
 

@@ -1,0 +1,401 @@
+#include "solvers/linalg/linear_solver.h"
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/IterativeLinearSolvers>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "solvers/linalg/blas_headroom.h"
+#include "solvers/linalg/prefactored_cholesky.h"
+
+namespace jello {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+constexpr double kResidualTolerance = 1e-8;
+
+}  // namespace
+
+struct SpdSolver::Impl {
+  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt;  // cholmod; cg's stale factor
+  Eigen::CholmodSimplicialLDLT<SparseMatrix, Eigen::Lower> ldlt;
+  Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::AMDOrdering<int>> ichol;
+  bool lltAnalyzed = false;
+  // cg: the operator (or A itself), the preconditioner's data, the work vectors.
+  const LinearOperator* op = nullptr;
+  const PrefactoredCholesky* projective = nullptr;  // projective
+  Eigen::VectorXd invDiagonal;                      // jacobi
+  std::array<Eigen::VectorXd, 6> blockInverse;      // block-jacobi: per point, upper triangle
+  bool staleFactor = false;                         // factor: llt holds an earlier A's factor
+  bool icholAnalyzed = false;
+  long lastIterations = 0;
+  Eigen::VectorXd r, z, p, q;
+  bool ldltAnalyzed = false;
+  bool useLdlt = false;             // this factorization went to LDLT
+  bool indefinite = false;          // cg met a direction of non-positive curvature
+  const SparseMatrix* A = nullptr;  // for the residual check
+
+  Impl() {
+    // CHOLMOD prints warnings to stdout by default: we report failures ourselves.
+    llt.cholmod().print = 0;
+    ldlt.cholmod().print = 0;
+  }
+
+  StepResult factorLdlt(const SparseMatrix& m, LinearSolverStats& stats) {
+    if (!ldltAnalyzed) {
+      ldlt.analyzePattern(m);
+      ++stats.analyses;
+      if (ldlt.info() != Eigen::Success) return StepResult::failure("LDLT analysis failed");
+      ldltAnalyzed = true;
+    }
+    ldlt.factorize(m);
+    if (ldlt.info() != Eigen::Success) {
+      return StepResult::failure("the LDLT factorization failed (singular system)");
+    }
+    return StepResult::success();
+  }
+
+  // LDLT succeeds silently on singular or badly indefinite systems: the answer is checked.
+  StepResult solveLdlt(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+    x = ldlt.solve(b);
+    if (ldlt.info() != Eigen::Success) return StepResult::failure("the LDLT solve failed");
+    const double residual = (*A * x - b).norm(), scale = b.norm();
+    if (!(residual <= kResidualTolerance * scale)) {
+      return StepResult::failure("the LDLT solution is inaccurate (relative residual " +
+                                 std::to_string(residual / scale) + ")");
+    }
+    return StepResult::success();
+  }
+};
+
+namespace {
+
+// The inverse of each point's symmetric 3x3 block (xx, xy, xz, yy, yz, zz arrays); false when
+// a block is not positive definite.
+bool invertBlocks(const std::array<const double*, 6>& g, Eigen::Index n,
+                  std::array<Eigen::VectorXd, 6>& inv) {
+  for (auto& v : inv) v.resize(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double a = g[0][i], b = g[1][i], c = g[2][i], d = g[3][i], e = g[4][i], f = g[5][i];
+    // Cofactors of [[a b c] [b d e] [c e f]].
+    const double A = d * f - e * e, B = c * e - b * f, C = b * e - c * d;
+    const double det = a * A + b * B + c * C;
+    if (!(a > 0.0 && a * d - b * b > 0.0 && det > 0.0) || !std::isfinite(det)) return false;
+    const double s = 1.0 / det;
+    inv[0][i] = A * s;
+    inv[1][i] = B * s;
+    inv[2][i] = C * s;
+    inv[3][i] = (a * f - c * c) * s;
+    inv[4][i] = (b * c - a * e) * s;
+    inv[5][i] = (a * d - b * b) * s;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<PreconditionerKind> parsePreconditioner(std::string_view name) {
+  if (name == "jacobi") return PreconditionerKind::Jacobi;
+  if (name == "block-jacobi") return PreconditionerKind::BlockJacobi;
+  if (name == "ichol") return PreconditionerKind::IncompleteCholesky;
+  if (name == "factor") return PreconditionerKind::Factor;
+  if (name == "projective") return PreconditionerKind::Projective;
+  return std::nullopt;
+}
+
+std::string_view preconditionerName(PreconditionerKind kind) {
+  switch (kind) {
+    case PreconditionerKind::Jacobi:
+      return "jacobi";
+    case PreconditionerKind::BlockJacobi:
+      return "block-jacobi";
+    case PreconditionerKind::IncompleteCholesky:
+      return "ichol";
+    case PreconditionerKind::Factor:
+      return "factor";
+    case PreconditionerKind::Projective:
+      return "projective";
+  }
+  return "?";
+}
+
+std::optional<LinearSolverKind> parseLinearSolver(std::string_view name) {
+  if (name == "cholmod") return LinearSolverKind::Cholmod;
+  if (name == "ldlt") return LinearSolverKind::Ldlt;
+  if (name == "cg") return LinearSolverKind::Cg;
+  return std::nullopt;
+}
+
+std::string_view linearSolverName(LinearSolverKind kind) {
+  switch (kind) {
+    case LinearSolverKind::Cholmod:
+      return "cholmod";
+    case LinearSolverKind::Ldlt:
+      return "ldlt";
+    case LinearSolverKind::Cg:
+      return "cg";
+  }
+  return "?";
+}
+
+SpdSolver::SpdSolver(LinearSolverKind kind, double cgTolerance)
+    : SpdSolver(LinearSolverOptions{kind, cgTolerance}) {}
+
+SpdSolver::SpdSolver(const LinearSolverOptions& options)
+    : kind_(options.kind),
+      preconditioner_(options.preconditioner),
+      cgTolerance_(options.cgTolerance),
+      impl_(std::make_unique<Impl>()) {}
+
+SpdSolver::~SpdSolver() = default;
+
+void SpdSolver::forgetPattern() {
+  impl_->lltAnalyzed = false;
+  impl_->ldltAnalyzed = false;
+  impl_->icholAnalyzed = false;
+  impl_->staleFactor = false;
+}
+
+StepResult SpdSolver::setUpPreconditioner(const SparseMatrix& A) {
+  Impl& s = *impl_;
+  const Eigen::Index n3 = A.rows(), n = n3 / 3;
+  switch (preconditioner_) {
+    case PreconditionerKind::Jacobi: {
+      const Eigen::VectorXd d = A.diagonal();
+      if (!(d.minCoeff() > 0.0)) {
+        return StepResult::failure("Jacobi preconditioner: a diagonal entry is not positive");
+      }
+      s.invDiagonal = d.cwiseInverse();
+      return StepResult::success();
+    }
+    case PreconditionerKind::BlockJacobi: {
+      std::array<Eigen::VectorXd, 6> blocks;  // from A when there is no operator
+      std::array<const double*, 6> g{};
+      if (s.op) {
+        g = s.op->diagonalBlocks();
+      } else {
+        constexpr int rows[6] = {0, 0, 0, 1, 1, 2}, cols[6] = {0, 1, 2, 1, 2, 2};
+        for (int e = 0; e < 6; ++e) {
+          blocks[e].resize(n);
+          for (Eigen::Index i = 0; i < n; ++i)
+            blocks[e][i] = A.coeff(rows[e] * n + i, cols[e] * n + i);
+          g[e] = blocks[e].data();
+        }
+      }
+      if (!invertBlocks(g, n, s.blockInverse)) {
+        return StepResult::failure("block-Jacobi preconditioner: a block is not positive definite");
+      }
+      return StepResult::success();
+    }
+    case PreconditionerKind::IncompleteCholesky:
+      if (!s.icholAnalyzed) {
+        s.ichol.analyzePattern(A);
+        s.icholAnalyzed = true;
+      }
+      s.ichol.factorize(A);
+      ++stats_.preconditionerFactorizations;
+      if (s.ichol.info() != Eigen::Success) {
+        return StepResult::failure("incomplete Cholesky failed");
+      }
+      return StepResult::success();
+    case PreconditionerKind::Factor:
+      if (s.staleFactor && s.lastIterations <= kStaleFactorIterations) {
+        return StepResult::success();  // the earlier factor still serves
+      }
+      if (!s.lltAnalyzed) {
+        s.llt.analyzePattern(A);
+        ++stats_.analyses;
+        if (s.llt.info() != Eigen::Success) return StepResult::failure("CHOLMOD analysis failed");
+        s.lltAnalyzed = true;
+      }
+      if (const std::string why = blasHeadroomProblem(); !why.empty()) {
+        return StepResult::resourceFailure(why);
+      }
+      s.llt.factorize(A);
+      ++stats_.preconditionerFactorizations;
+      s.lastIterations = 0;
+      s.staleFactor = s.llt.info() == Eigen::Success;
+      if (!s.staleFactor) {
+        return StepResult::failure(
+            "the preconditioner's factorization failed (not positive definite)");
+      }
+      return StepResult::success();
+    case PreconditionerKind::Projective:
+      if (!s.projective || !s.projective->factored() || s.projective->size() * 3 != n3) {
+        return StepResult::failure("the projective preconditioner has no factored Laplacian");
+      }
+      return StepResult::success();
+  }
+  return StepResult::success();
+}
+
+StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+  Impl& s = *impl_;
+  const Eigen::Index n3 = b.size(), n = n3 / 3;
+  if (x.size() != n3) x.setZero(n3);
+  const auto product = [&](const Eigen::VectorXd& v, Eigen::VectorXd& out) {
+    out.resize(n3);
+    if (s.op) {
+      s.op->apply(v.data(), out.data());
+    } else {
+      out.noalias() = *s.A * v;
+    }
+  };
+  StepResult preconditioned = StepResult::success();
+  const auto precondition = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+    switch (preconditioner_) {
+      case PreconditionerKind::Jacobi:
+        z = s.invDiagonal.cwiseProduct(r);
+        break;
+      case PreconditionerKind::BlockJacobi: {
+        z.resize(n3);
+        const auto& m = s.blockInverse;
+        for (Eigen::Index i = 0; i < n; ++i) {
+          const double rx = r[i], ry = r[n + i], rz = r[2 * n + i];
+          z[i] = m[0][i] * rx + m[1][i] * ry + m[2][i] * rz;
+          z[n + i] = m[1][i] * rx + m[3][i] * ry + m[4][i] * rz;
+          z[2 * n + i] = m[2][i] * rx + m[4][i] * ry + m[5][i] * rz;
+        }
+        break;
+      }
+      case PreconditionerKind::IncompleteCholesky:
+        z = s.ichol.solve(r);
+        break;
+      case PreconditionerKind::Factor:
+        z = s.llt.solve(r);
+        break;
+      case PreconditionerKind::Projective:
+        z = r;  // component-major: the x, y and z columns of one n x 3 system
+        if (preconditioned.ok) preconditioned = s.projective->solve(z.data(), 3);
+        break;
+    }
+  };
+  const double bNorm = b.norm();
+  if (bNorm == 0.0) {
+    x.setZero();
+    s.lastIterations = 0;
+    return StepResult::success();
+  }
+  const double tolerance = cgTolerance_ * bNorm;
+  const long maxIterations = std::max<long>(10, 2 * n3);
+  product(x, s.q);
+  s.r = b - s.q;
+  double residual = s.r.norm();
+  long it = 0;
+  if (residual > tolerance) {
+    precondition(s.r, s.z);
+    if (!preconditioned.ok) return preconditioned;
+    s.p = s.z;
+    double rz = s.r.dot(s.z);
+    while (true) {
+      product(s.p, s.q);
+      const double pq = s.p.dot(s.q);
+      if (!(pq > 0.0)) {
+        s.lastIterations = it;
+        s.indefinite = true;
+        return StepResult::failure(
+            "CG: the matrix is not positive definite (p.Ap = " + std::to_string(pq) + ")");
+      }
+      const double alpha = rz / pq;
+      x += alpha * s.p;
+      s.r -= alpha * s.q;
+      ++it;
+      residual = s.r.norm();
+      if (residual <= tolerance || it >= maxIterations) break;
+      precondition(s.r, s.z);
+      if (!preconditioned.ok) return preconditioned;
+      const double rzNext = s.r.dot(s.z);
+      s.p = s.z + (rzNext / rz) * s.p;
+      rz = rzNext;
+    }
+  }
+  stats_.cgIterations += it;
+  s.lastIterations = it;
+  if (!(residual <= tolerance)) {
+    std::ostringstream os;
+    os << "CG did not converge in " << it << " iterations (relative residual " << residual / bNorm
+       << ")";
+    return StepResult::failure(os.str());
+  }
+  return StepResult::success();
+}
+
+StepResult SpdSolver::factorize(const SparseMatrix& A, const LinearOperator* op,
+                                const PrefactoredCholesky* projective) {
+  const auto start = Clock::now();
+  Impl& s = *impl_;
+  s.A = &A;
+  s.useLdlt = false;
+  StepResult result = StepResult::success();
+  switch (kind_) {
+    case LinearSolverKind::Cholmod:
+      if (!s.lltAnalyzed) {
+        s.llt.analyzePattern(A);
+        ++stats_.analyses;
+        if (s.llt.info() != Eigen::Success) {
+          result = StepResult::failure("CHOLMOD analysis failed");
+          break;
+        }
+        s.lltAnalyzed = true;
+      }
+      if (const std::string why = blasHeadroomProblem(); !why.empty()) {
+        result = StepResult::resourceFailure(why);
+        break;
+      }
+      s.llt.factorize(A);
+      if (s.llt.info() == Eigen::Success) break;
+      // Not positive definite: fall back to LDLT, checked by the solution's residual.
+      ++stats_.fallbacks;
+      s.useLdlt = true;
+      result = s.factorLdlt(A, stats_);
+      break;
+    case LinearSolverKind::Ldlt:
+      s.useLdlt = true;
+      result = s.factorLdlt(A, stats_);
+      break;
+    case LinearSolverKind::Cg:
+      s.op = op;
+      s.projective = projective;
+      result = setUpPreconditioner(A);
+      break;
+  }
+  ++stats_.factorizations;
+  stats_.factorSeconds += secondsSince(start);
+  return result;
+}
+
+StepResult SpdSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+  const auto start = Clock::now();
+  Impl& s = *impl_;
+  StepResult result = StepResult::success();
+  if (kind_ == LinearSolverKind::Cg && !s.useLdlt) {
+    s.indefinite = false;
+    result = conjugateGradients(b, x);
+    // Not positive definite (possible only with the clamp off): LDLT until the next factorize,
+    // as cholmod falls back.
+    if (!result.ok && s.indefinite) {
+      ++stats_.fallbacks;
+      result = s.factorLdlt(*s.A, stats_);
+      s.useLdlt = result.ok;
+      if (result.ok) result = s.solveLdlt(b, x);
+    }
+  } else if (s.useLdlt) {
+    result = s.solveLdlt(b, x);
+  } else {
+    x = s.llt.solve(b);
+    if (s.llt.info() != Eigen::Success) result = StepResult::failure("the CHOLMOD solve failed");
+  }
+  if (result.ok && !x.allFinite()) result = StepResult::failure("the solution is not finite");
+  ++stats_.solves;
+  stats_.solveSeconds += secondsSince(start);
+  return result;
+}
+
+}  // namespace jello

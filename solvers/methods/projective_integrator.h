@@ -1,0 +1,89 @@
+// projective: backward Euler by the prefactored local/global iterations of projective dynamics
+// (Liu et al. 2013, "Fast Simulation of Mass-Spring Systems"; Bouaziz et al. 2014). The step is
+// the minimizer of the same incremental potential as `implicit`,
+//   E(x) = 1/(2h^2) |x - y|_M^2 + U(x),   y = x0 + h v0,
+// with each spring's energy k/2 |(x_b - x_a) - d|^2 minimized over directions d of length L0
+// and each violated contact's kc/2 |x - p|^2 over points p of the free side. One iteration:
+//   local   every spring projects to its rest length, d = L0 u; every point on a solid side
+//           projects onto the surface, p (both happen inside the model's force evaluation:
+//           f_spring = -L x + sum k (e_b - e_a) d and f_contact = -W (x - p), exactly);
+//   global  (M/h^2 + L + W) x_next = M y/h^2 + sum k (e_b - e_a) d + W p + f_other,
+// which is one solve per coordinate with a matrix that depends only on the springs, h and the
+// contact set:
+//   x_next = x - A^-1 r(x),   r(x) = M (x - y)/h^2 - f(x, (x - x0)/h)   (backward Euler's
+//   residual), A_c = M/h^2 + L + W_c,    L = sum_s k_s (e_a - e_b)(e_a - e_b)^T (the spring
+//   Laplacian),
+// W_c diagonal: kc for each wall a point violates along coordinate c (its exact Hessian), and kc
+// for each plane or sphere contact on all three coordinates (kc I >= kc n n^T, so every
+// iteration still lowers the projective energy). A is factored with CHOLMOD once per scene and
+// step size, and again only for a coordinate whose contact set changed (a change of a few
+// points by CHOLMOD's rank-one updates and downdates of the factor, cholmod_updown); the factor
+// is shared between coordinates whose matrices are equal. Spring and contact damping, the force
+// field and the user force are evaluated at the iterate (lagged one iteration): at the fixed point
+// they are exactly where backward Euler evaluates them, so the iterations converge to the
+// `implicit` step, damping included (the lag converges because h c/(m + k h^2) << 1).
+// Options: iterations per step (10) and a tolerance (m): the iterations stop early when an
+// update moves no coordinate more than it (0: always all iterations); Chebyshev acceleration
+// (ProjectiveOptions::chebyshevRho).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "solvers/integrator.h"
+#include "solvers/linalg/chebyshev_weights.h"
+#include "solvers/system/jacobian.h"
+
+namespace jello {
+
+class SpringLaplacian;
+
+class ProjectiveIntegrator final : public Integrator {
+ public:
+  explicit ProjectiveIntegrator(const ProjectiveOptions& options = {});
+  ~ProjectiveIntegrator() override;
+  explicit ProjectiveIntegrator(const SolverOptions& options)
+      : ProjectiveIntegrator(options.projective) {}
+
+  IntegratorKind kind() const override { return IntegratorKind::Projective; }
+  StepResult step(const Model& model, State& state, double h) override;
+  std::vector<Statistic> statistics() const override;
+
+  // The last step's iterations and its last update's largest coordinate (m).
+  int lastIterations() const { return lastIterations_; }
+  double lastUpdate() const { return lastUpdate_; }
+  long refactorizations() const { return factorizations_; }
+
+ private:
+  void bind(const Model& model);
+  // The contact weights of every coordinate at positions x (3n) for the points [lo, hi); true
+  // when one differs from the weights of the factor its coordinate uses.
+  bool contactWeights(const Model& model, const double* x, std::ptrdiff_t lo, std::ptrdiff_t hi);
+  StepResult factorChanged(double h);
+
+  ProjectiveOptions options_;
+  ChebyshevWeights chebyshev_;
+  long modelId_ = -1;
+  int n_ = 0;
+  double mass_ = 0.0;
+  double h_ = 0.0;  // the step size the factors are for
+  std::unique_ptr<SpringLaplacian> laplacian_;
+  std::array<SparseMatrix, 3> A_;                             // per coordinate: M/h^2 + L + W_c
+  std::array<Eigen::VectorXd, 3> weights_, factoredWeights_;  // W_c: wanted, factored
+  std::array<int, 3> factorOf_{{0, 1, 2}};  // which coordinate's factor each one uses
+  struct Factors;                           // CHOLMOD's, one per distinct matrix
+  std::unique_ptr<Factors> factors_;
+  bool factored_ = false;
+  Eigen::VectorXd y_, x_, v_, f_, previous_;  // previous_: the iterate before x_; v_: (x_ - x0)/h
+  Eigen::MatrixXd delta_;                     // n x 3, the update of each coordinate
+  int lastIterations_ = 0;
+  double lastUpdate_ = 0.0;
+  std::vector<std::pair<int, double>> changes_;  // a coordinate's changed contact weights
+  long steps_ = 0, iterations_ = 0, factorizations_ = 0, contactChanges_ = 0, updates_ = 0;
+  double factorSeconds_ = 0.0, solveSeconds_ = 0.0;
+};
+
+}  // namespace jello

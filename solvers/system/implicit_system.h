@@ -1,0 +1,92 @@
+// The one implicit system that every implicit integrator and CVODE solve. Bound to one model
+// (by its id, never its address), it holds the force Jacobians K = df/dx and D = df/dv (pattern
+// built once per model; the terms come from each effect, Model::addJacobian), the system matrix
+//   A = M - a D - b K
+// in the same pattern, and the linear solver that factors and solves it. Every implicit method
+// solves with such an A:
+//   implicit-linear                        a = h,                b = h^2
+//   implicit, midpoint, newmark, bdf2      a = sigma h^2/gamma,  b = theta h^2/gamma
+//                                          (solvers/methods/newton_integrators.h)
+//   cvode                                  a = g,                b = g^2 (the reduced Newton
+//                                          matrix of its first-order system)
+// so a new effect needs only its addJacobian, and a new implicit method only its a and b.
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "solvers/integrator.h"
+#include "solvers/linalg/linear_solver.h"
+#include "solvers/system/jacobian.h"
+#include "solvers/system/system_operator.h"
+
+namespace jello {
+
+class PrefactoredCholesky;
+class SpringLaplacian;
+
+class ImplicitSystem {
+ public:
+  ImplicitSystem(const LinearSolverOptions& linearSolver, bool clampCompression);
+  ~ImplicitSystem();
+
+  // Binds to `model`; true when it is another model than the last (the pattern is rebuilt and
+  // the solver analyses afresh: integrators must forget their history then).
+  bool bind(const Model& model);
+  bool bound() const { return jacobian_ != nullptr; }
+
+  // K and D at positions x (3n): the last assembly until the next.
+  void assemble(const double* x);
+  // A = M - a D - b K of the last assembly, written into A().
+  void formMatrix(double a, double b);
+  // A as formed, factored (CHOLMOD) or prepared (CG: the preconditioner set up and, matrix-free,
+  // A's blocks gathered for the product; CG then solves with this A until the next factorize).
+  StepResult factorize();
+  // formMatrix(a, b), then factorize().
+  StepResult factorize(double a, double b);
+  // x: on entry CG's initial guess, on return the solution of A x = rhs.
+  StepResult solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x);
+
+  // The projective matrix P(a, b) = M + L(a c + b k) + C on each coordinate of the bound model
+  // (solvers/system/spring_laplacian.h), factored when a, b or C changed: CG's projective
+  // preconditioner and Newton's seed iterations. C, diagonal, bounds the contact springs' part of
+  // A: per point in contact, b kc + a dc for each wall, the plane, the sphere and each obstacle
+  // it is inside of (kc n n^T <= kc I), given as `contact` (n values, null: none). factorize()
+  // sets P up itself for CG, with the contacts of the last assembly's positions.
+  StepResult factorProjective(double a, double b, const Eigen::VectorXd* contact = nullptr);
+  // v <- P^-1 v (3n, component-major) with the last factorProjective.
+  StepResult solveProjective(Eigen::VectorXd& v) const;
+
+  const SparseMatrix& K() const { return jacobian_->K(); }
+  const SparseMatrix& D() const { return jacobian_->D(); }
+  const SparseMatrix& A() const { return A_; }
+  const SpdSolver& solver() const { return solver_; }
+  long clampCount() const { return jacobian_ ? jacobian_->totalClampCount() : 0; }
+
+  // compression_clamps, factorizations, ldlt_fallbacks, assemble/factor/solve times and (CG)
+  // cg_iterations, appended to out.
+  void appendStatistics(std::vector<Statistic>& out) const;
+
+ private:
+  bool clampCompression_;
+  long modelId_ = -1;
+  const Model* model_ = nullptr;  // the one of the last bind: alive while a step runs
+  bool matrixFree_;
+  std::unique_ptr<JacobianAssembler> jacobian_;
+  std::unique_ptr<SystemOperator> operator_;  // cg, matrix-free
+  SparseMatrix A_;
+  double a_ = 0.0, b_ = 0.0;  // of the last formMatrix
+  SpdSolver solver_;
+  std::unique_ptr<SpringLaplacian> laplacian_;  // projective: built on first use per model
+  std::unique_ptr<PrefactoredCholesky> projective_;
+  SparseMatrix projectiveMatrix_;
+  double projectiveA_ = -1.0, projectiveB_ = -1.0;  // what projective_ holds
+  Eigen::VectorXd projectiveContact_;               // C of projective_ (empty: none)
+  Eigen::VectorXd x_, contact_;                     // the last assembly's positions; C there
+  long projectiveFactorizations_ = 0;
+  double projectiveSeconds_ = 0.0;
+  double assembleSeconds_ = 0.0;
+};
+
+}  // namespace jello

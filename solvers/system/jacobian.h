@@ -1,0 +1,62 @@
+// The Jacobians of the total force: K = df/dx and D = df/dv (3n x 3n, component-major ordering
+// like the state, N/m and N*s/m), assembled into sparse matrices whose pattern is built once
+// and whose values are refilled in place at every state (no triplets, no re-analysis). The
+// terms themselves live beside each effect's force (Model::addJacobian,
+// src/effects/jacobian_blocks.h: springs, walls, plane, sphere, field); this class owns the pattern
+// (every point's diagonal block and both off-diagonal blocks of every spring, which never changes
+// with contact) and scatters the diagonal blocks into it. The compression clamp (on by default,
+// counted) projects each spring's element Hessian onto semidefinite matrices, so M - h D - h^2 K
+// stays positive definite. The field's gradient is not symmetric and is left out unless asked for
+// (not for Cholesky).
+#pragma once
+
+#include <Eigen/SparseCore>
+#include <vector>
+
+#include "src/model.h"
+
+namespace jello {
+
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+
+struct JacobianOptions {
+  bool clampCompression = true;
+  bool includeField = false;  // the field's gradient is not symmetric: not for Cholesky
+};
+
+class JacobianAssembler {
+ public:
+  explicit JacobianAssembler(const Model& model);
+
+  // Refills K and D at positions x, 3n component-major (the forces are linear in v: D does not
+  // depend on it).
+  void assemble(const double* x, const JacobianOptions& options);
+
+  const SparseMatrix& K() const { return K_; }
+  const SparseMatrix& D() const { return D_; }
+
+  // A = mass I - alpha D - beta K, written into A's values. A must have the pattern of K (use
+  // pattern() to make one); the values are combined array-wise.
+  void combine(double alpha, double beta, SparseMatrix& A) const;
+  const SparseMatrix& pattern() const { return K_; }
+
+  // Where the values of each spring's blocks (a,b), (b,a) (18 per spring, in the order of
+  // SpringForces::springs()) and of each point's diagonal block (9 per point) are in the
+  // pattern's value array: what SystemOperator gathers.
+  const std::vector<int>& springSlots() const { return springSlots_; }
+  const std::vector<int>& diagonalSlots() const { return diagSlots_; }
+
+  long lastClampCount() const { return lastClamps_; }  // springs clamped in the last assembly
+  long totalClampCount() const { return totalClamps_; }
+
+ private:
+  const Model& model_;
+  SparseMatrix K_, D_;
+  std::vector<int> springSlots_;       // 18 per spring: value index of blocks (a,b), (b,a)
+  std::vector<int> diagSlots_;         // 9 per point: value index of its diagonal block
+  std::vector<double> diagK_, diagD_;  // 9 per point: diagonal blocks gathered densely
+  std::vector<int> diagonal_;          // value index of each diagonal entry (for the mass)
+  long lastClamps_ = 0, totalClamps_ = 0;
+};
+
+}  // namespace jello

@@ -1,0 +1,152 @@
+#include "src/effects/contact.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+
+namespace jello {
+namespace {
+
+// block += scale * u u^T, block 3x3 row-major.
+void addOuter(double* block, const Vec3& u, double scale) {
+  const double c[3] = {u.x, u.y, u.z};
+  for (int r = 0; r < 3; ++r)
+    for (int q = 0; q < 3; ++q) block[3 * r + q] += scale * c[r] * c[q];
+}
+
+double* blockOf(double* diag, int p) {
+  return diag + 9 * static_cast<std::ptrdiff_t>(p);
+}
+
+}  // namespace
+
+// The loops below are branch-free (selects, an OR reduction) so that they vectorize: they run
+// in every force evaluation.
+
+bool WallContact::allInside(const double* __restrict x, int n, int lo, int hi) {
+  int outside = 0;
+  for (int e = 0; e < 3; ++e)
+    for (int i = e * n + lo; i < e * n + hi; ++i) outside |= std::abs(x[i]) > kBoxHalfSize;
+  return outside == 0;
+}
+
+void WallContact::accumulate(const double* __restrict x, const double* __restrict v,
+                             double* __restrict f, int n, int lo, int hi) const {
+  // Each component is its own pair of walls: normal -/+ e_c, so the spring acts on that
+  // component alone.
+  const double k = k_.stiffness, c = k_.damping;
+  for (int e = 0; e < 3; ++e)
+    for (int i = e * n + lo; i < e * n + hi; ++i) {
+      const double over = x[i] - kBoxHalfSize, under = x[i] + kBoxHalfSize;
+      const double depth = over > 0.0 ? over : under < 0.0 ? under : 0.0;
+      f[i] -= depth != 0.0 ? k * depth + c * v[i] : 0.0;
+    }
+}
+
+double WallContact::energy(const double* x, int n) const {
+  double e = 0.0;
+  for (int i = 0; i < 3 * n; ++i) {
+    const double depth = std::max(0.0, std::abs(x[i]) - kBoxHalfSize);
+    e += depth * depth;
+  }
+  return 0.5 * k_.stiffness * e;
+}
+
+void WallContact::addJacobian(const double* x, int n, JacobianBlocks& out) const {
+  for (int axis = 0; axis < 3; ++axis)
+    for (int p = 0; p < n; ++p) {
+      if (std::abs(x[axis * n + p]) <= kBoxHalfSize) continue;
+      blockOf(out.diagK, p)[4 * axis] -= k_.stiffness;  // entry (axis, axis) of the block
+      blockOf(out.diagD, p)[4 * axis] -= k_.damping;
+    }
+}
+
+PlaneContact::PlaneContact(const Plane& plane, ContactConstants k) : k_(k) {
+  // Scaled by the largest coefficient first: normals from 1e-300 to 1e300 give the same plane.
+  const Vec3 n{plane.a, plane.b, plane.c};
+  const double scale = maxAbs(n);
+  const Vec3 scaled{n.x / scale, n.y / scale, n.z / scale};  // 1/scale overflows if subnormal
+  const double len = norm(scaled);
+  normal_ = scaled * (1.0 / len);
+  offset_ = (plane.d / scale) / len;
+}
+
+void PlaneContact::accumulate(const double* __restrict x, const double* __restrict v,
+                              double* __restrict f, int n, int lo, int hi) const {
+  const double ux = normal_.x, uy = normal_.y, uz = normal_.z;
+  const double k = k_.stiffness, c = k_.damping;
+  for (int p = lo; p < hi; ++p) {
+    const double dist = ux * x[p] + uy * x[n + p] + uz * x[2 * n + p] + offset_;
+    const double vn = ux * v[p] + uy * v[n + p] + uz * v[2 * n + p];
+    const double s = dist < 0.0 ? -k * dist - c * vn : 0.0;
+    f[p] += s * ux;
+    f[n + p] += s * uy;
+    f[2 * n + p] += s * uz;
+  }
+}
+
+double PlaneContact::energy(const double* x, int n) const {
+  double e = 0.0;
+  for (int p = 0; p < n; ++p) {
+    const double dist =
+        normal_.x * x[p] + normal_.y * x[n + p] + normal_.z * x[2 * n + p] + offset_;
+    if (dist < 0.0) e += dist * dist;
+  }
+  return 0.5 * k_.stiffness * e;
+}
+
+void PlaneContact::addJacobian(const double* x, int n, JacobianBlocks& out) const {
+  for (int p = 0; p < n; ++p) {
+    const Vec3 xp{x[p], x[n + p], x[2 * n + p]};
+    if (dot(normal_, xp) + offset_ >= 0.0) continue;
+    addOuter(blockOf(out.diagK, p), normal_, -k_.stiffness);
+    addOuter(blockOf(out.diagD, p), normal_, -k_.damping);
+  }
+}
+
+void SphereContact::accumulate(const double* x, const double* v, double* f, int n, int lo,
+                               int hi) const {
+  const Vec3 c = sphere_.center;
+  const double r = sphere_.radius;
+  for (int p = lo; p < hi; ++p) {
+    const Vec3 d{x[p] - c.x, x[n + p] - c.y, x[2 * n + p] - c.z};
+    const double l2 = dot(d, d);
+    if (l2 >= r * r) continue;
+    const double l = std::sqrt(l2);
+    const Vec3 u = l > 0.0 ? d * (1.0 / l) : Vec3{0.0, 0.0, 1.0};  // centre: push up
+    const double vn = u.x * v[p] + u.y * v[n + p] + u.z * v[2 * n + p];
+    const double s = k_.stiffness * (r - l) - k_.damping * vn;
+    f[p] += s * u.x;
+    f[n + p] += s * u.y;
+    f[2 * n + p] += s * u.z;
+  }
+}
+
+double SphereContact::energy(const double* x, int n) const {
+  double e = 0.0;
+  for (int p = 0; p < n; ++p) {
+    const Vec3 d{x[p] - sphere_.center.x, x[n + p] - sphere_.center.y,
+                 x[2 * n + p] - sphere_.center.z};
+    const double depth = sphere_.radius - norm(d);
+    if (depth > 0.0) e += depth * depth;
+  }
+  return 0.5 * k_.stiffness * e;
+}
+
+void SphereContact::addJacobian(const double* x, int n, JacobianBlocks& out) const {
+  const double R = sphere_.radius;
+  for (int p = 0; p < n; ++p) {
+    const Vec3 r = Vec3{x[p], x[n + p], x[2 * n + p]} - sphere_.center;
+    const double l = norm(r);
+    if (!(l < R && l > 0.0)) continue;
+    const Vec3 u = r * (1.0 / l);
+    // The curvature term kc (R/l - 1)(I - n n^T): positive, dropped by the clamp.
+    const double t = out.clampCompression ? 0.0 : k_.stiffness * (R / l - 1.0);
+    double* K = blockOf(out.diagK, p);
+    addOuter(K, u, -k_.stiffness - t);
+    for (int e = 0; e < 3; ++e) K[4 * e] += t;
+    addOuter(blockOf(out.diagD, p), u, -k_.damping);
+  }
+}
+
+}  // namespace jello

@@ -1,0 +1,188 @@
+#include "src/effects/obstacles.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace jello {
+
+namespace {
+
+Vec3 at(const double* x, int n, int p) {
+  return {x[p], x[n + p], x[2 * n + p]};
+}
+
+// Any unit vector perpendicular to unit d.
+Vec3 perpendicular(const Vec3& d) {
+  const Vec3 a = std::abs(d.x) < 0.9 ? Vec3{1.0, 0.0, 0.0} : Vec3{0.0, 1.0, 0.0};
+  return unitVector(cross(d, a));
+}
+
+void setOuter(double* m, const Vec3& a, const Vec3& b, double s) {
+  const double u[3] = {a.x, a.y, a.z}, w[3] = {b.x, b.y, b.z};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) m[3 * i + j] += s * u[i] * w[j];
+}
+
+}  // namespace
+
+std::optional<Penetration> conePenetration(const Cone& cone, const Vec3& x) {
+  const Vec3 d = unitVector(cone.axis);
+  const Vec3 rel = x - cone.apex;
+  const double h = dot(d, rel);
+  if (!(h > 0.0 && h < cone.height)) return std::nullopt;
+  const Vec3 radial = rel - d * h;
+  const double r = norm(radial);
+  const double H = cone.height, R = cone.radius, L = std::hypot(H, R);
+  const double lateral = (h * R - r * H) / L;  // distance to the lateral surface, > 0 inside
+  if (!(lateral > 0.0)) return std::nullopt;
+  const double base = H - h;
+  Penetration p;
+  if (lateral <= base) {
+    const Vec3 er = r > 0.0 ? radial * (1.0 / r) : perpendicular(d);
+    p.depth = lateral;
+    p.gradient = (d * R - er * H) * (1.0 / L);
+    if (r > 0.0) {
+      // d(er)/dx = (I - d d^T - er er^T) / r.
+      const double s = -H / (L * r);
+      for (int e = 0; e < 3; ++e) p.hessian[4 * e] += s;
+      setOuter(p.hessian, d, d, -s);
+      setOuter(p.hessian, er, er, -s);
+    }
+  } else {
+    p.depth = base;
+    p.gradient = d * -1.0;
+  }
+  return p;
+}
+
+std::optional<Penetration> spiralPenetration(const Spiral& s, const Vec3& x) {
+  const double px = x.x - s.cx, py = x.y - s.cy;
+  const double r = std::hypot(px, py);
+  if (!(r > s.rInner && r < s.rOuter) || r == 0.0) return std::nullopt;
+  const double c = s.pitch / (2.0 * std::numbers::pi);
+  double theta = std::atan2(py, px);
+  if (theta < 0.0) theta += 2.0 * std::numbers::pi;
+  const double span = 2.0 * std::numbers::pi * s.turns;
+  // The turn whose slab holds x: top = zTop - c Theta above x by less than the thickness.
+  double top = std::numeric_limits<double>::quiet_NaN(), big = theta;
+  for (; big <= span; big += 2.0 * std::numbers::pi) {
+    const double depth = s.zTop - c * big - x.z;
+    if (depth > 0.0 && depth < s.thickness) {
+      top = depth;
+      break;
+    }
+  }
+  if (std::isnan(top)) return std::nullopt;
+  const double r2 = r * r, r4 = r2 * r2;
+  // grad(theta) and its Hessian (in x and y).
+  const Vec3 gt{-py / r2, px / r2, 0.0};
+  const double txx = 2.0 * px * py / r4, tyy = -txx, txy = (py * py - px * px) / r4;
+  const Vec3 er{px / r, py / r, 0.0};
+  const double bottom = s.thickness - top, outer = s.rOuter - r;
+  const double inner = s.rInner > 0.0 ? r - s.rInner : std::numeric_limits<double>::infinity();
+  Penetration p;
+  const auto vertical = [&](double depth, double sign) {
+    // top: depth = zTop - c theta - z (+ const); bottom: the same with the opposite sign.
+    p.depth = depth;
+    p.gradient = (gt * -c + Vec3{0.0, 0.0, -1.0}) * sign;
+    const double h[9] = {-c * txx, -c * txy, 0, -c * txy, -c * tyy, 0, 0, 0, 0};
+    for (int i = 0; i < 9; ++i) p.hessian[i] = sign * h[i];
+  };
+  const auto radial = [&](double depth, double sign) {
+    // outer: depth = rOuter - r (sign -1); inner: depth = r - rInner (sign +1).
+    p.depth = depth;
+    p.gradient = er * sign;
+    const double k = sign / r;  // Hess(r) = (I2 - er er^T) / r in x, y
+    const double h[9] = {k * (1 - er.x * er.x),
+                         -k * er.x * er.y,
+                         0,
+                         -k * er.x * er.y,
+                         k * (1 - er.y * er.y),
+                         0,
+                         0,
+                         0,
+                         0};
+    for (int i = 0; i < 9; ++i) p.hessian[i] = h[i];
+  };
+  // The two ends of the ramp: the arc length r Theta from the start, r (span - Theta) to the
+  // end, so that the depth falls to 0 on every face (no energy jumps at the ends).
+  const double start = r * big, end = r * (span - big);
+  const auto cap = [&](double depth, double sign, double angle) {
+    // depth = r * angle with angle = Theta (start, sign +1) or span - Theta (end, sign -1).
+    p.depth = depth;
+    p.gradient = er * angle + gt * (r * sign);
+    const double hr[4] = {(1 - er.x * er.x) / r, -er.x * er.y / r, -er.x * er.y / r,
+                          (1 - er.y * er.y) / r};
+    const double ht[4] = {txx, txy, txy, tyy};
+    const double e[2] = {er.x, er.y}, g[2] = {gt.x, gt.y};
+    for (int i = 0; i < 2; ++i) {
+      for (int j = 0; j < 2; ++j) {
+        p.hessian[3 * i + j] =
+            angle * hr[2 * i + j] + sign * (e[i] * g[j] + g[i] * e[j]) + sign * r * ht[2 * i + j];
+      }
+    }
+  };
+  const double least = std::min({top, bottom, outer, inner, start, end});
+  if (least == top) {
+    vertical(top, 1.0);
+  } else if (least == bottom) {
+    vertical(bottom, -1.0);
+  } else if (least == outer) {
+    radial(outer, -1.0);
+  } else if (least == inner) {
+    radial(inner, 1.0);
+  } else if (least == start) {
+    cap(start, 1.0, big);
+  } else {
+    cap(end, -1.0, span - big);
+  }
+  return p;
+}
+
+ObstacleContact::ObstacleContact(const Cone& cone, ContactConstants k) : cone_(cone), k_(k) {}
+ObstacleContact::ObstacleContact(const Spiral& spiral, ContactConstants k)
+    : spiral_(spiral), k_(k) {}
+
+std::optional<Penetration> ObstacleContact::penetration(const Vec3& x) const {
+  return cone_ ? conePenetration(*cone_, x) : spiralPenetration(*spiral_, x);
+}
+
+void ObstacleContact::accumulate(const double* x, const double* v, double* f, int n, int lo,
+                                 int hi) const {
+  for (int p = lo; p < hi; ++p) {
+    const std::optional<Penetration> q = penetration(at(x, n, p));
+    if (!q) continue;
+    const Vec3 nrm = unitVector(q->gradient * -1.0);
+    const double vn = dot(nrm, at(v, n, p));
+    const Vec3 force = q->gradient * (-k_.stiffness * q->depth) - nrm * (k_.damping * vn);
+    f[p] += force.x;
+    f[n + p] += force.y;
+    f[2 * n + p] += force.z;
+  }
+}
+
+double ObstacleContact::energy(const double* x, int n) const {
+  double e = 0.0;
+  for (int p = 0; p < n; ++p) {
+    if (const std::optional<Penetration> q = penetration(at(x, n, p))) e += q->depth * q->depth;
+  }
+  return 0.5 * k_.stiffness * e;
+}
+
+void ObstacleContact::addJacobian(const double* x, int n, JacobianBlocks& out) const {
+  for (int p = 0; p < n; ++p) {
+    const std::optional<Penetration> q = penetration(at(x, n, p));
+    if (!q) continue;
+    double* K = out.diagK + 9 * p;
+    setOuter(K, q->gradient, q->gradient, -k_.stiffness);
+    if (!out.clampCompression) {
+      for (int i = 0; i < 9; ++i) K[i] -= k_.stiffness * q->depth * q->hessian[i];
+    }
+    const Vec3 nrm = unitVector(q->gradient * -1.0);
+    setOuter(out.diagD + 9 * p, nrm, nrm, -k_.damping);
+  }
+}
+
+}  // namespace jello

@@ -1,0 +1,54 @@
+// The extra-credit obstacles beyond the plane and the sphere: a solid cone and a spiral ramp,
+// with the same penalty contact (src/PHYSICS.md). Each is described by its penetration depth
+// phi(x) > 0 inside the solid, its gradient and Hessian; then for a point inside
+//   energy = 1/2 kc phi^2,   f = -kc phi grad(phi) - dc (n.v) n,   n = -grad(phi)/|grad(phi)|,
+//   K = -kc (grad(phi) grad(phi)^T + phi Hess(phi)),   D = -dc n n^T,
+// the Hessian term (the surface's curvature) dropped under the clamp, as the sphere's is.
+//   cone:   phi = the depth below the nearer of the lateral surface and the base disk (exact
+//           distances, |grad(phi)| = 1);
+//   spiral: phi = the least of the vertical depth below the helicoid top, the height above the
+//           slab's bottom, the distances to the outer and inner cylinders, and the arc lengths
+//           to the ramp's two ends (so phi falls to 0 on every face: no energy jumps).
+#pragma once
+
+#include <optional>
+
+#include "src/effects/contact.h"
+#include "src/effects/jacobian_blocks.h"
+#include "src/world/world.h"
+
+namespace jello {
+
+struct Penetration {
+  double depth = 0.0;                               // m, > 0
+  Vec3 gradient;                                    // of the depth (points into the solid)
+  double hessian[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};  // row-major, of the depth
+};
+
+// The penetration of point x into a cone or a spiral ramp, or nothing when x is outside.
+std::optional<Penetration> conePenetration(const Cone& cone, const Vec3& x);
+std::optional<Penetration> spiralPenetration(const Spiral& spiral, const Vec3& x);
+
+// Penalty contact with one of them; all arrays component-major, n points.
+class ObstacleContact {
+ public:
+  ObstacleContact(const Cone& cone, ContactConstants k);
+  ObstacleContact(const Spiral& spiral, ContactConstants k);
+  const ContactConstants& constants() const { return k_; }
+  std::optional<Penetration> penetration(const Vec3& x) const;
+  bool inside(const Vec3& x) const { return penetration(x).has_value(); }
+  void accumulate(const double* x, const double* v, double* f, int n) const {
+    accumulate(x, v, f, n, 0, n);
+  }
+  // The points [lo, hi) only.
+  void accumulate(const double* x, const double* v, double* f, int n, int lo, int hi) const;
+  double energy(const double* x, int n) const;
+  void addJacobian(const double* x, int n, JacobianBlocks& out) const;
+
+ private:
+  std::optional<Cone> cone_;
+  std::optional<Spiral> spiral_;
+  ContactConstants k_;
+};
+
+}  // namespace jello

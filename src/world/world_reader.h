@@ -1,0 +1,49 @@
+// Reads a world file (README "World files"): the original course format, then an optional
+// extension block after the velocities. Every error names file, line and token; nothing
+// half-read is ever returned.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "src/world/world.h"
+
+namespace jello {
+
+// Hostile sizes are refused before anything is allocated for them.
+struct ReaderLimits {
+  int maxFieldResolution = 128;            // nodes per axis: 128^3 nodes = 50 MB
+  int maxCubeResolution = 64;              // points per axis: 64^3 points
+  std::uintmax_t maxFileBytes = 1u << 28;  // 256 MiB
+  // An integrator name not in our table is accepted (the world keeps RK4 and records the name
+  // in World::unknownIntegrator) when the caller overrides the integrator anyway: files by
+  // other authors of the course name integrators they added (`Midpoint`, `IPC`).
+  bool acceptUnknownIntegrator = false;
+};
+
+class WorldFileError : public std::runtime_error {
+ public:
+  // `tokenBytes`: the token's full length when `token` holds only its start (0: its own size).
+  WorldFileError(std::string file, int line, std::string token, const std::string& message,
+                 std::size_t tokenBytes = 0);
+
+  const std::string& file() const { return file_; }
+  int line() const { return line_; }  // 1-based; 0 when the file could not be opened
+  const std::string& token() const { return token_; }
+
+ private:
+  std::string file_;
+  int line_;
+  std::string token_;
+};
+
+// Throws WorldFileError.
+World readWorld(const std::filesystem::path& path, const ReaderLimits& limits = {});
+
+// Parses a world from text; `name` is what error messages call the file.
+World parseWorld(std::string_view text, const std::string& name, const ReaderLimits& limits = {});
+
+}  // namespace jello
