@@ -34,7 +34,10 @@ import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import closed_sets  # noqa: E402
 from readme_blocks import write_blocks  # noqa: E402
+
+INTEGRATORS = {r["name"]: r for r in closed_sets.integrators()}
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 WORLD = os.path.join(ROOT, "worlds", "spinning-k1e4.w")
@@ -59,20 +62,28 @@ def label(name):
     return VARIANTS.get(name, f"`{name}`")
 
 
-# integrator, dt (s), extra jello-sim arguments
-RUNS = [
-    ("rk4", 1e-4, []),
-    ("implicit", 0.01, []),
-    ("implicit", 0.01, ["--linear-solver", "cholmod"]),
-    ("implicit", 0.01, ["--preconditioner", "projective", "--newton-seed", "60",
-                        "--newton-seed-tol", "1e-8", "--newton-seed-chebyshev", "0.9"]),
-    ("implicit-linear", 0.01, []),
-    ("midpoint", 0.01, []),
-    ("newmark", 0.01, []),
-    ("bdf2", 0.01, []),
-    ("cvode", 0.01, ["--rtol", "1e-6"]),
-    ("projective", 0.01, []),
-]
+# The reference: RK4 at a step far below its limit.
+REFERENCE = ("rk4", 1e-4, [])
+# Settings of one integrator run beside its defaults (the VARIANTS above).
+VARIANT_RUNS = {
+    "implicit": [["--linear-solver", "cholmod"],
+                 ["--preconditioner", "projective", "--newton-seed", "60",
+                  "--newton-seed-tol", "1e-8", "--newton-seed-chebyshev", "0.9"]],
+}
+
+
+def runs():
+    """(integrator, dt (s), extra jello-sim arguments): the reference, then every implicit and
+    adaptive integrator of the table (src/world/integrator_table.h) at dt = 0.01 s in the
+    studies' order, each followed by its variants; the adaptive ones at rtol 1e-6."""
+    out = [REFERENCE]
+    for name in closed_sets.study_order():
+        row = INTEGRATORS[name]
+        if row["explicit"]:
+            continue
+        out.append((name, 0.01, ["--rtol", "1e-6"] if row["adaptive"] else []))
+        out += [(name, 0.01, extra) for extra in VARIANT_RUNS.get(name, [])]
+    return out
 COLUMNS = ["integrator", "settings", "dt_s", "simulated_s", "steps", "energy_start_J",
            "energy_end_J",
            "energy_kept", "angular_momentum_kept", "wall_time_s", "wall_time_per_step_ms",
@@ -296,7 +307,7 @@ def main():
         dirty = bool(subprocess.run(["git", "-C", ROOT, "status", "--porcelain",
                                      "--untracked-files=no"], capture_output=True,
                                     text=True).stdout.strip())
-        rows = [run(args.bin, *r) for r in RUNS]
+        rows = [run(args.bin, *r) for r in runs()]
         with tempfile.NamedTemporaryFile("w", newline="", delete=False,
                                          dir=os.path.dirname(CSV)) as f:
             writer = csv.DictWriter(f, fieldnames=COLUMNS)
@@ -310,7 +321,7 @@ def main():
                     cpu = line.split(":", 1)[1].strip()
                     break
         sidecar = {"command_line": sys.argv, "world": os.path.relpath(WORLD, ROOT),
-                   "runs": [{"integrator": i, "dt_s": dt, "extra": e} for i, dt, e in RUNS],
+                   "runs": [{"integrator": i, "dt_s": dt, "extra": e} for i, dt, e in runs()],
                    "commit": commit, "tree_modified": dirty, "cpu": cpu,
                    "cores": os.cpu_count(), "kernel": platform.release(),
                    "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS", ""),

@@ -23,13 +23,24 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import closed_sets  # noqa: E402
 from readme_blocks import replace_block  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RESULTS = os.path.join(ROOT, "experiments", "results")
 README = os.path.join(ROOT, "README.md")
-ORDER = ["rk4", "symplectic", "euler", "implicit", "cvode", "implicit-linear", "midpoint",
-         "newmark", "bdf2", "projective"]
+INTEGRATORS = {r["name"]: r for r in closed_sets.integrators()}
+
+
+def explicit_first(names):
+    """The explicit integrators first, the most stable first (the table's explicit rows
+    reversed: rk4, symplectic, euler), then the others in the given order."""
+    explicit = [n for n in names if INTEGRATORS[n]["explicit"]]
+    return explicit[::-1] + [n for n in names if not INTEGRATORS[n]["explicit"]]
+
+
+# The stability table's rows: the integrator table's order, explicit ones first.
+ORDER = explicit_first(list(INTEGRATORS))
 
 
 def read_rows(name):
@@ -121,8 +132,17 @@ def stability_summary():
     return "\n".join(lines)
 
 
-PRECISION_ORDER = ["rk4", "symplectic", "euler", "implicit", "implicit-linear", "midpoint",
-                   "newmark", "bdf2", "projective", "cvode bdf", "cvode adams"]
+
+
+def precision_labels(rows):
+    """The work-precision table's rows: the studies' order (adaptive last), explicit ones first,
+    an adaptive integrator once per method the data has ("cvode bdf", "cvode adams")."""
+    labels = []
+    for name in explicit_first(closed_sets.study_order()):
+        methods = dict.fromkeys(r["cvode_method"] for r in rows if r["integrator"] == name)
+        labels += [name if m == "none" else f"{name} {m}" for m in methods]
+    return labels
+
 ACCURACIES = [1e-2, 1e-3, 1e-4, 1e-6]  # m, largest position error over the window
 
 
@@ -150,7 +170,7 @@ def work_precision_summary():
                   + " | smallest error reached |",
                   "|---|" + "---|" * (len(ACCURACIES) + 1)]
         best = {}
-        for label in PRECISION_ORDER:
+        for label in precision_labels(rows):
             integ, _, method = label.partition(" ")
             runs = [r for r in rows if r["scene"] == name and r["integrator"] == integ
                     and (r["cvode_method"] == (method or "none"))]
@@ -166,7 +186,7 @@ def work_precision_summary():
                     cells.append("not reached")
                     continue
                 r = min(ok, key=lambda r: float(r["wall_time_s"]))
-                setting = (f"rtol {float(r['rtol']):g}" if integ == "cvode"
+                setting = (f"rtol {float(r['rtol']):g}" if INTEGRATORS[integ]["adaptive"]
                            else f"dt {float(r['dt_s']):.3g}")
                 cells.append(f"{seconds(float(r['wall_time_s']))} ({setting})")
                 best.setdefault(a, []).append((float(r["wall_time_s"]), label))
@@ -235,10 +255,11 @@ def scaling_summary():
     sidecar = read_sidecar("scaling")
     cost = {(int(r["n"]), r["integrator"], r["linear_solver"]): r for r in rows}
     ns = sorted({int(r["n"]) for r in rows})
-    columns = [("rk4", "none", "rk4"), ("symplectic", "none", "symplectic"),
-               ("euler", "none", "euler"), ("implicit", "cholmod", "implicit, CHOLMOD"),
-               ("implicit", "cg", "implicit, CG"), ("cvode", "cholmod", "cvode, CHOLMOD"),
-               ("cvode", "cg", "cvode, CG")]
+    # A column per (integrator, linear solver) the data has, in ORDER and the solvers' table's.
+    solvers = ["none"] + [r["name"] for r in closed_sets.linear_solvers()]
+    columns = [(integ, solver, integ if solver == "none" else f"{integ}, {solver.upper()}")
+               for integ in ORDER for solver in solvers
+               if any((n, integ, solver) in cost for n in ns)]
 
     def per_s(r):
         return float(r["wall_per_simulated_s"])
@@ -316,7 +337,7 @@ def atlas_run_text(sidecar, ks):
             + (f" for k = {', '.join(k_text(k) for k in ks)}" if ks else ""))
 
 
-ATLAS_EXPLICIT = {"euler", "symplectic", "rk4"}
+ATLAS_EXPLICIT = {name for name, r in INTEGRATORS.items() if r["explicit"]}
 
 
 def atlas_cheapest(rows, explicit=None):
@@ -353,7 +374,7 @@ def atlas_summary(subdirectory=""):
             def text(r):
                 if r is None:
                     return "none"
-                step = (f"rtol {float(r['rtol']):.0e}" if r["integrator"] == "cvode"
+                step = (f"rtol {float(r['rtol']):.0e}" if INTEGRATORS[r["integrator"]]["adaptive"]
                         else f"dt {float(r['dt_s']):.3g}")
                 return f"{r['integrator']} {seconds(float(r['wall_per_simulated_s']))} ({step})"
 

@@ -13,10 +13,10 @@
 # without gravity: no contact) at N = 8 (one core), then at N = 16 for k = 1e5, 1e6, 1e7 (a 60 s
 # budget, two points at a time) into experiments/results/atlas_free/, and draws its charts
 # (about 8 and 30 minutes on a 2-core VM).
+# `scripts/run-experiments.sh charts` runs nothing: it redraws every chart from the committed CSV.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
-scripts/build.sh release >/dev/null
 bin=build/release/bin
 out=experiments/results
 args=()
@@ -28,6 +28,25 @@ if [ "${1:-}" = quick ]; then
   stability_scenes=free
   precision_scenes=soft
 fi
+# The atlas's charts cover every N committed (the atlas-only runs' files included).
+draw_atlas() {
+  local ns
+  ns=$(awk -F, 'FNR > 1 { print $2 }' "$out"/*_atlas.csv | sort -nu | tr '\n' ' ')
+  gnuplot -e "dir='$out'; atlas_ns='$ns'" experiments/plots/scaling.gp
+}
+draw_free_atlas() {
+  gnuplot -e "dir='$out/atlas_free'; atlas_ns='8 16'; atlas_only=1; scene=' (free flight)'" \
+    experiments/plots/scaling.gp
+}
+if [ "${1:-}" = charts ]; then
+  gnuplot -e "dir='$out'; scenes='$stability_scenes'" experiments/plots/stability.gp
+  gnuplot -e "dir='$out'; scenes='$precision_scenes'" experiments/plots/work_precision.gp
+  draw_atlas
+  draw_free_atlas
+  echo "run-experiments: charts redrawn in $out/"
+  exit 0
+fi
+scripts/build.sh release >/dev/null
 # Committed results come from a clean tree: each sidecar records its commit, which must be the
 # code that ran. JELLO_ALLOW_DIRTY=1 runs anyway (the sidecars then say "tree_modified": true).
 if [ "$out" = experiments/results ] && [ -z "${JELLO_ALLOW_DIRTY:-}" ] &&
@@ -37,12 +56,6 @@ if [ "$out" = experiments/results ] && [ -z "${JELLO_ALLOW_DIRTY:-}" ] &&
   exit 1
 fi
 mkdir -p "$out"
-# The atlas's charts cover every N committed (the atlas-only runs' files included).
-draw_atlas() {
-  local ns
-  ns=$(awk -F, 'FNR > 1 { print $2 }' "$out"/*_atlas.csv | sort -nu | tr '\n' ' ')
-  gnuplot -e "dir='$out'; atlas_ns='$ns'" experiments/plots/scaling.gp
-}
 if [ "${1:-}" = atlas ]; then
   export OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1
   # A run of 60 s is allowed (20 at N = 8): at N = 16 and 32 a converged implicit second costs
@@ -71,8 +84,7 @@ if [ "${1:-}" = atlas-free ]; then
     --out-dir "$free"
   "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 16 --atlas-k 1e5,1e6,1e7 \
     --atlas-budget 60 --jobs 2 --name atlas16 --out-dir "$free"
-  gnuplot -e "dir='$free'; atlas_ns='8 16'; atlas_only=1; scene=' (free flight)'" \
-    experiments/plots/scaling.gp
+  draw_free_atlas
   echo "run-experiments: the free scene's atlas in $free/"
   exit 0
 fi

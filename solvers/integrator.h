@@ -1,7 +1,7 @@
 // The one seam between physics and time stepping: an Integrator advances a State by h using
 // only the Model (forces and Jacobians). The wings implement it (solvers/methods/,
 // solvers/cvode/); solvers/integrator_factory.h builds one from the integrator table
-// (src/world/integrator_name.h), so any world can be stepped by any integrator.
+// (src/world/integrator_table.h), so any world can be stepped by any integrator.
 #pragma once
 
 #include <optional>
@@ -13,7 +13,7 @@
 #include "solvers/step_result.h"
 #include "src/model.h"
 #include "src/state.h"
-#include "src/world/integrator_name.h"
+#include "src/world/integrator_table.h"
 
 namespace jello {
 

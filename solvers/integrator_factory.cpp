@@ -10,8 +10,8 @@ namespace jello {
 
 std::unique_ptr<Integrator> makeIntegrator(IntegratorKind kind, const SolverOptions& options) {
   switch (kind) {
-#define JELLO_MAKE_INTEGRATOR(kind, name, fileName, Class, summary) \
-  case IntegratorKind::kind:                                        \
+#define JELLO_MAKE_INTEGRATOR(kind, name, fileName, Class, family, model, summary) \
+  case IntegratorKind::kind:                                                       \
     return std::make_unique<Class>(options);
     JELLO_INTEGRATORS(JELLO_MAKE_INTEGRATOR)
 #undef JELLO_MAKE_INTEGRATOR

@@ -1,4 +1,4 @@
-// The factory behind the integrator table (src/world/integrator_name.h): each row names the
+// The factory behind the integrator table (src/world/integrator_table.h): each row names the
 // class that implements it, constructed from the solver options. The one file of the face that
 // knows every implementation.
 #pragma once

@@ -9,7 +9,7 @@
 #include "solvers/integrator_factory.h"
 #include "src/base/assertions.h"
 #include "src/base/parallel.h"
-#include "src/world/integrator_name.h"
+#include "src/world/integrator_table.h"
 
 namespace jello {
 

@@ -6,12 +6,9 @@
 namespace jello {
 
 struct ImplicitOptions {
-  // CG (Jacobi, matrix-free) by default: it takes the same converged steps in well under
-  // CHOLMOD's time on jello.w and the spinning cube (BM_ImplicitIntegratorStep, README "Implicit
-  // solvers"); CHOLMOD stays faster where one kept factorization serves every step (a stiff
-  // cube at rest). An indefinite system (the clamp off) falls back to LDLT as CHOLMOD's does.
-  LinearSolverKind linearSolver = LinearSolverKind::Cg;
-  PreconditionerKind preconditioner = PreconditionerKind::Jacobi;  // cg's
+  // An indefinite system (the clamp off) falls back to LDLT as CHOLMOD's does.
+  LinearSolverKind linearSolver = kDefaultLinearSolver;
+  PreconditionerKind preconditioner = kDefaultPreconditioner;  // cg's
   bool matrixFree = true;  // cg: products through the spring kernels, not the sparse matrix
   // The converged integrators (implicit, midpoint, newmark, bdf2;
   // solvers/methods/newton_integrators.h).
@@ -68,10 +65,8 @@ struct CvodeOptions {
   bool stabilityLimitDetection = true;
   double maxStep = 0.0;            // s, 0: no limit
   long maxStepsPerCall = 1000000;  // internal steps CVODE may take to reach one output time
-  // CG (Jacobi, matrix-free): 4x faster than CHOLMOD on 1 s of jello.w at rtol 1e-3
-  // (BM_CvodeOneSecond, README "Implicit solvers").
-  LinearSolverKind linearSolver = LinearSolverKind::Cg;
-  PreconditionerKind preconditioner = PreconditionerKind::Jacobi;
+  LinearSolverKind linearSolver = kDefaultLinearSolver;
+  PreconditionerKind preconditioner = kDefaultPreconditioner;
   bool matrixFree = true;
   // bdf: Newton's systems by SUNDIALS' SPGMR (matrix-free: CVODE's difference-quotient J v,
   // its tolerance set by CVODE), preconditioned by the reduced system solved with linearSolver,

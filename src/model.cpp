@@ -32,11 +32,16 @@ Model::Model(ModelSpec spec)
       mass_(spec.mass),
       springs_(std::move(spec.springs), spec.numPoints) {
   JELLO_ASSERT(n_ > 0 && mass_ > 0.0, "a model has points of positive mass");
-  if (spec.walls) walls_.emplace(spec.contact);
-  if (spec.plane) plane_.emplace(*spec.plane, spec.contact);
-  if (spec.sphere) sphere_.emplace(*spec.sphere, spec.contact);
-  if (spec.cone) obstacles_.emplace_back(*spec.cone, spec.contact);
-  if (spec.spiral) obstacles_.emplace_back(*spec.spiral, spec.contact);
+  // In the obstacle table's order (src/effects/obstacle.h).
+  if (spec.walls) obstacles_.push_back(std::make_unique<WallContact>(spec.contact));
+  if (spec.plane) obstacles_.push_back(std::make_unique<PlaneContact>(*spec.plane, spec.contact));
+  if (spec.sphere) {
+    obstacles_.push_back(std::make_unique<SphereContact>(*spec.sphere, spec.contact));
+  }
+  if (spec.cone) obstacles_.push_back(std::make_unique<ObstacleContact>(*spec.cone, spec.contact));
+  if (spec.spiral) {
+    obstacles_.push_back(std::make_unique<ObstacleContact>(*spec.spiral, spec.contact));
+  }
   if (!spec.field.empty()) {
     FieldForces field(std::move(spec.field));
     if (!field.isZero()) field_.emplace(std::move(field));
@@ -51,30 +56,29 @@ void Model::forces(const double* x, const double* v, double* f, PointRangeRef th
   evaluate(x, v, f, 1.0, then);
 }
 
-bool Model::addPointForces(const double* x, const double* v, double* f, int lo, int hi) const {
+unsigned Model::addPointForces(const double* x, const double* v, double* f, int lo, int hi) const {
   const int n = n_;
-  const bool walls = walls_ && !WallContact::allInside(x, n, lo, hi);
-  if (walls) walls_->accumulate(x, v, f, n, lo, hi);
-  if (plane_) plane_->accumulate(x, v, f, n, lo, hi);
-  if (sphere_) sphere_->accumulate(x, v, f, n, lo, hi);
-  for (const ObstacleContact& o : obstacles_) o.accumulate(x, v, f, n, lo, hi);
+  unsigned evaluated = 0;
+  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+    if (obstacles_[i]->addForces(x, v, f, n, lo, hi)) evaluated |= 1u << i;
+  }
   if (field_) field_->accumulate(x, f, n, lo, hi);
   if (userForce_) {
     const double* u = userForce_->data();
     for (int e = 0; e < 3; ++e)
       for (int i = e * n + lo; i < e * n + hi; ++i) f[i] += u[i];
   }
-  return walls;
+  return evaluated;
 }
 
-void Model::countEvaluation(bool wallsEvaluated) const {
+void Model::countEvaluation(unsigned obstaclesEvaluated) const {
   const auto count = [](std::atomic<long>& c) { c.fetch_add(1, std::memory_order_relaxed); };
   Counters& c = *counters_;
   count(c.springs);
-  if (walls_) count(wallsEvaluated ? c.walls : c.wallsSkipped);
-  if (plane_) count(c.plane);
-  if (sphere_) count(c.sphere);
-  for (std::size_t i = 0; i < obstacles_.size(); ++i) count(c.obstacles);
+  for (std::size_t i = 0; i < obstacles_.size(); ++i) {
+    const auto kind = static_cast<std::size_t>(obstacles_[i]->kind());
+    count((obstaclesEvaluated >> i) & 1u ? c.obstacles[kind] : c.skipped[kind]);
+  }
   if (field_) count(c.field);
   if (userForce_) count(c.user);
 }
@@ -82,8 +86,19 @@ void Model::countEvaluation(bool wallsEvaluated) const {
 EffectCounts Model::counts() const {
   const auto get = [](const std::atomic<long>& c) { return c.load(std::memory_order_relaxed); };
   const Counters& c = *counters_;
-  return {get(c.springs), get(c.walls), get(c.wallsSkipped), get(c.plane),
-          get(c.sphere),  get(c.field), get(c.user),         get(c.obstacles)};
+  EffectCounts out{get(c.springs), get(c.field), get(c.user), {}, {}};
+  for (std::size_t k = 0; k < kObstacleKinds; ++k) {
+    out.obstacles[k] = get(c.obstacles[k]);
+    out.skipped[k] = get(c.skipped[k]);
+  }
+  return out;
+}
+
+const Obstacle* Model::obstacle(ObstacleKind kind) const {
+  for (const auto& o : obstacles_) {
+    if (o->kind() == kind) return o.get();
+  }
+  return nullptr;
 }
 
 void Model::setUserForce(const Eigen::VectorXd& f) {
@@ -105,7 +120,7 @@ void Model::evaluate(const double* x, const double* v, double* f, double scale,
   // kParallelMinPoints), then on each thread's block the rest of the forces, the scaling and
   // then().
   const std::ptrdiff_t n = n_;
-  std::atomic<bool> walls{false};  // evaluated on some block
+  std::atomic<unsigned> evaluated{0};  // bit i: obstacle i evaluated on some block
   runOverPointBlocks(
       pointBlocks(),
       [&](std::ptrdiff_t setLo, std::ptrdiff_t setHi, std::ptrdiff_t lo, std::ptrdiff_t hi) {
@@ -113,16 +128,15 @@ void Model::evaluate(const double* x, const double* v, double* f, double scale,
         springs_.accumulateRange(x, v, f, lo, hi);
       },
       [&](std::ptrdiff_t lo, std::ptrdiff_t hi) {
-        if (addPointForces(x, v, f, static_cast<int>(lo), static_cast<int>(hi))) {
-          walls.store(true, std::memory_order_relaxed);
-        }
+        evaluated.fetch_or(addPointForces(x, v, f, static_cast<int>(lo), static_cast<int>(hi)),
+                           std::memory_order_relaxed);
         if (scale != 1.0) {
           for (std::ptrdiff_t e = 0; e < 3; ++e)
             for (std::ptrdiff_t i = e * n + lo; i < e * n + hi; ++i) f[i] *= scale;
         }
         then(lo, hi);
       });
-  countEvaluation(walls.load(std::memory_order_relaxed));
+  countEvaluation(evaluated.load(std::memory_order_relaxed));
 }
 
 void Model::forces(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& f) const {
@@ -140,48 +154,22 @@ void Model::acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
 
 void Model::addJacobian(const double* x, JacobianBlocks& out) const {
   springs_.addJacobian(x, out);
-  if (walls_) walls_->addJacobian(x, n_, out);
-  if (plane_) plane_->addJacobian(x, n_, out);
-  if (sphere_) sphere_->addJacobian(x, n_, out);
-  for (const ObstacleContact& o : obstacles_) o.addJacobian(x, n_, out);
+  for (const auto& o : obstacles_) o->addJacobian(x, n_, out);
   if (field_) field_->addJacobian(x, n_, out);
 }
 
 bool Model::contactBegins(const double* x0, const double* x1) const {
-  const int n = n_;
-  if (walls_) {
-    for (int i = 0; i < 3 * n; ++i) {
-      if (std::abs(x1[i]) > kBoxHalfSize && std::abs(x0[i]) <= kBoxHalfSize) return true;
-    }
-  }
-  for (int p = 0; p < n; ++p) {
-    const Vec3 a{x0[p], x0[n + p], x0[2 * n + p]}, b{x1[p], x1[n + p], x1[2 * n + p]};
-    if (plane_) {
-      const auto side = [&](const Vec3& x) { return dot(plane_->normal(), x) + plane_->offset(); };
-      if (side(b) < 0.0 && side(a) >= 0.0) return true;
-    }
-    if (sphere_) {
-      const Sphere& s = sphere_->sphere();
-      if (norm(b - s.center) < s.radius && norm(a - s.center) >= s.radius) return true;
-    }
-    for (const ObstacleContact& o : obstacles_) {
-      if (o.inside(b) && !o.inside(a)) return true;
-    }
+  for (const auto& o : obstacles_) {
+    if (o->contactBegins(x0, x1, n_)) return true;
   }
   return false;
 }
 
 bool Model::inContact(const double* x) const {
-  const int n = n_;
-  if (walls_) {
-    for (int i = 0; i < 3 * n; ++i) {
-      if (std::abs(x[i]) > kBoxHalfSize) return true;
+  for (const auto& o : obstacles_) {
+    for (int p = 0; p < n_; ++p) {
+      if (o->depth(pointAt(x, n_, p)) > 0.0) return true;
     }
-  }
-  if (!hasSolids()) return false;
-  const auto one = [](const ContactConstants&) { return 1.0; };
-  for (int p = 0; p < n; ++p) {
-    if (solidContactWeight({x[p], x[n + p], x[2 * n + p]}, one) > 0.0) return true;
   }
   return false;
 }
@@ -214,10 +202,7 @@ Vec3 Model::angularMomentum(const State& s) const {
 
 double Model::potentialEnergy(const double* x) const {
   double e = springs_.energy(x);
-  if (walls_) e += walls_->energy(x, n_);
-  if (plane_) e += plane_->energy(x, n_);
-  if (sphere_) e += sphere_->energy(x, n_);
-  for (const ObstacleContact& o : obstacles_) e += o.energy(x, n_);
+  for (const auto& o : obstacles_) e += o->energy(x, n_);
   return e;
 }
 
@@ -231,10 +216,7 @@ Energy Model::energy(const Eigen::VectorXd& x, const Eigen::VectorXd& v) const {
   Energy e;
   e.kinetic = 0.5 * mass_ * v.squaredNorm();
   e.spring = springs_.energy(x.data());
-  if (walls_) e.contact += walls_->energy(x.data(), n_);
-  if (plane_) e.contact += plane_->energy(x.data(), n_);
-  if (sphere_) e.contact += sphere_->energy(x.data(), n_);
-  for (const ObstacleContact& o : obstacles_) e.contact += o.energy(x.data(), n_);
+  for (const auto& o : obstacles_) e.contact += o->energy(x.data(), n_);
   return e;
 }
 

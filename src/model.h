@@ -1,12 +1,14 @@
 // The physical model of a scene: n equal point masses and the effects the scene has.
 //   a = (sum of forces) / m
-// Effects: elastic springs (always), walls of the box [-2,2]^3 (skipped in a step where every
-// point is inside), and only when the scene has them: the inclined plane, the sphere, the force
-// field (an all-zero field is dropped, a uniform one is a constant force). This is the one seam
-// integrators use: forces/acceleration of a state, and its energy.
+// Effects: elastic springs (always), the obstacles (src/effects/obstacle.h: the walls of the
+// box [-2,2]^3, skipped in a block of points that are all inside, and only when the scene has
+// them the inclined plane, the sphere, the cone and the spiral ramp), the force field (an
+// all-zero field is dropped, a uniform one is a constant force) and a user force. This is the
+// one seam integrators use: forces/acceleration of a state, its Jacobians, and its energy.
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <atomic>
 #include <memory>
 #include <optional>
@@ -41,7 +43,7 @@ ModelSpec modelSpecFromWorld(const World& world);
 struct Energy {
   double kinetic = 0.0;  // J
   double spring = 0.0;   // J, elastic springs
-  double contact = 0.0;  // J, penalty springs of walls, plane and sphere
+  double contact = 0.0;  // J, penalty springs of every obstacle
   double total() const { return kinetic + spring + contact; }
 };
 
@@ -49,13 +51,13 @@ struct Energy {
 // A snapshot of the model's counters, which are atomic (threads may share a model).
 struct EffectCounts {
   long springs = 0;
-  long walls = 0;
-  long wallsSkipped = 0;  // evaluations where every point was inside the box
-  long plane = 0;
-  long sphere = 0;
   long field = 0;
   long user = 0;
-  long obstacles = 0;  // evaluations of the cone and spiral contacts
+  // Per obstacle kind: evaluations, and those skipped because no point touched (the walls').
+  std::array<long, kObstacleKinds> obstacles{};
+  std::array<long, kObstacleKinds> skipped{};
+  long of(ObstacleKind kind) const { return obstacles[static_cast<std::size_t>(kind)]; }
+  long skippedOf(ObstacleKind kind) const { return skipped[static_cast<std::size_t>(kind)]; }
 };
 
 class Model {
@@ -91,29 +93,11 @@ class Model {
   void forces(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& f) const;
   void acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v, Eigen::VectorXd& a) const;
 
-  // True when some point is in contact (with a wall, the plane or the sphere) at positions x1
-  // but was not at x0: the contact set changed between them.
+  // True when some point is in contact with some obstacle at positions x1 but was not at x0:
+  // the contact set changed between them.
   bool contactBegins(const double* x0, const double* x1) const;
-  // True when some point is in contact (wall, plane, sphere or obstacle) at positions x.
+  // True when some point is in contact with some obstacle at positions x.
   bool inContact(const double* x) const;
-  // Any plane, sphere or obstacle at all.
-  bool hasSolids() const { return plane_ || sphere_ || !obstacles_.empty(); }
-  // The contact constants of the plane, sphere and obstacles x is on the solid side of, each
-  // mapped by weight(const ContactConstants&) and summed (0 when it is inside none): the
-  // diagonal contact weights of the projective matrices (solvers/).
-  template <class Weight>
-  double solidContactWeight(const Vec3& x, const Weight& weight) const {
-    double w = 0.0;
-    if (plane_ && dot(plane_->normal(), x) + plane_->offset() < 0.0)
-      w += weight(plane_->constants());
-    if (sphere_ && norm(x - sphere_->sphere().center) < sphere_->sphere().radius) {
-      w += weight(sphere_->constants());
-    }
-    for (const ObstacleContact& o : obstacles_) {
-      if (o.inside(x)) w += weight(o.constants());
-    }
-    return w;
-  }
 
   // Work (J) the force field does on the points moving from x0 to x1 (3n each), by the
   // trapezoid rule along the straight path: sum of 1/2 (F(x0) + F(x1)) . (x1 - x0). Exact for
@@ -138,16 +122,13 @@ class Model {
   void addJacobian(const double* x, JacobianBlocks& out) const;
 
   const SpringForces& springs() const { return springs_; }
-  // The effects, for Jacobian assembly: empty when the scene does not have them.
-  const std::optional<WallContact>& walls() const { return walls_; }
-  const std::optional<PlaneContact>& plane() const { return plane_; }
-  const std::optional<SphereContact>& sphere() const { return sphere_; }
-  // The cone and the spiral ramp, where the scene has them.
-  const std::vector<ObstacleContact>& obstacles() const { return obstacles_; }
+  // The scene's obstacles, in the order of the obstacle table (src/effects/obstacle.h): what
+  // CVODE's roots, the implicit system and projective's contact weights iterate.
+  const std::vector<std::unique_ptr<Obstacle>>& obstacles() const { return obstacles_; }
+  // The obstacle of that kind, or null when the scene has none.
+  const Obstacle* obstacle(ObstacleKind kind) const;
+  bool has(ObstacleKind kind) const { return obstacle(kind) != nullptr; }
   const std::optional<FieldForces>& field() const { return field_; }
-  bool hasWalls() const { return walls_.has_value(); }
-  bool hasPlane() const { return plane_.has_value(); }
-  bool hasSphere() const { return sphere_.has_value(); }
   bool hasField() const { return field_.has_value(); }
   EffectCounts counts() const;
 
@@ -169,25 +150,22 @@ class Model {
   // there: forces() and both acceleration()s.
   void evaluate(const double* x, const double* v, double* f, double scale,
                 PointRangeRef then) const;
-  // Adds every effect but the springs at the points [lo, hi) to f; false when the walls were
-  // skipped there (all points inside the box).
-  bool addPointForces(const double* x, const double* v, double* f, int lo, int hi) const;
-  // Counts one evaluation of every effect the scene has.
-  void countEvaluation(bool wallsEvaluated) const;
+  // Adds every effect but the springs at the points [lo, hi) to f; bit i of the result: the
+  // i-th obstacle evaluated them (not skipped).
+  unsigned addPointForces(const double* x, const double* v, double* f, int lo, int hi) const;
+  // Counts one evaluation of every effect the scene has (bit i: obstacle i was not skipped).
+  void countEvaluation(unsigned obstaclesEvaluated) const;
 
   long id_;
   int n_;
   double mass_;
   SpringForces springs_;
-  std::optional<WallContact> walls_;
-  std::optional<PlaneContact> plane_;
-  std::optional<SphereContact> sphere_;
-  std::vector<ObstacleContact> obstacles_;
+  std::vector<std::unique_ptr<Obstacle>> obstacles_;
   std::optional<FieldForces> field_;
   std::optional<Eigen::VectorXd> userForce_;
   struct Counters {
-    std::atomic<long> springs{0}, walls{0}, wallsSkipped{0}, plane{0}, sphere{0}, field{0}, user{0},
-        obstacles{0};
+    std::atomic<long> springs{0}, field{0}, user{0};
+    std::array<std::atomic<long>, kObstacleKinds> obstacles{}, skipped{};
   };
   // unique_ptr keeps the model movable; relaxed increments: counts, not synchronization.
   std::unique_ptr<Counters> counters_ = std::make_unique<Counters>();

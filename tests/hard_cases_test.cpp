@@ -80,17 +80,12 @@ double fieldWork(const World& w, const State& start, const State& now) {
   return work;
 }
 
-// How far the deepest point is inside a wall, the plane or the sphere (m).
+// How far the deepest point is inside any obstacle (m; 0: touching none).
 double deepestPenetration(const Model& model, const State& s) {
-  double deepest = s.x.cwiseAbs().maxCoeff() - kBoxHalfSize;
-  for (int p = 0; p < s.numPoints(); ++p) {
-    const Vec3 x = s.position(p);
-    if (model.plane()) {
-      deepest = std::max(deepest, -(dot(model.plane()->normal(), x) + model.plane()->offset()));
-    }
-    if (model.sphere()) {
-      const Sphere& sphere = model.sphere()->sphere();
-      deepest = std::max(deepest, sphere.radius - norm(x - sphere.center));
+  double deepest = 0.0;
+  for (const auto& obstacle : model.obstacles()) {
+    for (int p = 0; p < s.numPoints(); ++p) {
+      deepest = std::max(deepest, obstacle->depth(s.position(p)));
     }
   }
   return deepest;

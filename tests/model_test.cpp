@@ -22,13 +22,13 @@ namespace {
 
 TEST(Model, BuildsOnlyTheEffectsTheSceneHas) {
   const Model moveLeft(test::loadWorld("moveLeft.w"));  // no plane, all-zero field
-  EXPECT_TRUE(moveLeft.hasWalls());
-  EXPECT_FALSE(moveLeft.hasPlane());
+  EXPECT_TRUE(moveLeft.has(ObstacleKind::Walls));
+  EXPECT_FALSE(moveLeft.has(ObstacleKind::Plane));
   EXPECT_FALSE(moveLeft.hasField());
-  EXPECT_FALSE(moveLeft.hasSphere());
+  EXPECT_FALSE(moveLeft.has(ObstacleKind::Sphere));
 
   const Model rotate(test::loadWorld("rotate.w"));
-  EXPECT_TRUE(rotate.hasPlane());
+  EXPECT_TRUE(rotate.has(ObstacleKind::Plane));
   EXPECT_TRUE(rotate.hasField());
 }
 
@@ -39,11 +39,11 @@ TEST(Model, AnAbsentEffectIsNotEvaluated) {
   Eigen::VectorXd f;
   for (int i = 0; i < 5; ++i) model.forces(s.x, s.v, f);
   EXPECT_EQ(model.counts().springs, 5);
-  EXPECT_EQ(model.counts().plane, 0);
-  EXPECT_EQ(model.counts().sphere, 0);
+  EXPECT_EQ(model.counts().of(ObstacleKind::Plane), 0);
+  EXPECT_EQ(model.counts().of(ObstacleKind::Sphere), 0);
   EXPECT_EQ(model.counts().field, 0);
-  EXPECT_EQ(model.counts().walls, 0);  // the cube starts inside the box
-  EXPECT_EQ(model.counts().wallsSkipped, 5);
+  EXPECT_EQ(model.counts().of(ObstacleKind::Walls), 0);  // the cube starts inside the box
+  EXPECT_EQ(model.counts().skippedOf(ObstacleKind::Walls), 5);
 }
 
 TEST(Model, AUserForceIsAddedAsGivenAndCostsNothingOnceCleared) {
@@ -70,7 +70,7 @@ TEST(Model, WallsAreEvaluatedOnceAPointIsOutside) {
   const State s = initialState(w);
   Eigen::VectorXd f, g;
   model.forces(s.x, s.v, f);
-  EXPECT_EQ(model.counts().walls, 1);
+  EXPECT_EQ(model.counts().of(ObstacleKind::Walls), 1);
   EXPECT_GT(f[0], 0.0);  // pushed back in +x
 
   World inside = w;
@@ -78,7 +78,7 @@ TEST(Model, WallsAreEvaluatedOnceAPointIsOutside) {
   const Model free(inside);
   const State t = initialState(inside);
   free.forces(t.x, t.v, g);
-  EXPECT_EQ(free.counts().wallsSkipped, 1);
+  EXPECT_EQ(free.counts().skippedOf(ObstacleKind::Walls), 1);
 }
 
 TEST(Model, AUniformFieldAddsTheSameForceToEveryPoint) {
@@ -131,9 +131,9 @@ TEST(Model, ThreadedAccelerationThenEqualsTheSerialOne) {
   w.sphere = Sphere{c, 0.3};
   Model model(w);
   model.setUserForce(Eigen::VectorXd::LinSpaced(3 * n, -1.0, 1.0));
-  ASSERT_GT(model.walls()->energy(s.x.data(), n), 0.0);
-  ASSERT_GT(model.plane()->energy(s.x.data(), n), 0.0);
-  ASSERT_GT(model.sphere()->energy(s.x.data(), n), 0.0);
+  ASSERT_GT(model.obstacle(ObstacleKind::Walls)->energy(s.x.data(), n), 0.0);
+  ASSERT_GT(model.obstacle(ObstacleKind::Plane)->energy(s.x.data(), n), 0.0);
+  ASSERT_GT(model.obstacle(ObstacleKind::Sphere)->energy(s.x.data(), n), 0.0);
   ASSERT_GT(s.x.head(n).minCoeff(), -kBoxHalfSize);
   setParallelThreads(1);
   Eigen::VectorXd serial(3 * n);
@@ -154,10 +154,10 @@ TEST(Model, ThreadedAccelerationThenEqualsTheSerialOne) {
     EXPECT_EQ(std::count(visits.begin(), visits.end(), 1), n);
     const EffectCounts after = model.counts();
     EXPECT_EQ(after.springs - before.springs, 1);
-    EXPECT_EQ(after.walls - before.walls, 1);
-    EXPECT_EQ(after.wallsSkipped, before.wallsSkipped);
-    EXPECT_EQ(after.plane - before.plane, 1);
-    EXPECT_EQ(after.sphere - before.sphere, 1);
+    for (ObstacleKind kind : {ObstacleKind::Walls, ObstacleKind::Plane, ObstacleKind::Sphere}) {
+      EXPECT_EQ(after.of(kind) - before.of(kind), 1) << obstacleName(kind);
+      EXPECT_EQ(after.skippedOf(kind), before.skippedOf(kind)) << obstacleName(kind);
+    }
     EXPECT_EQ(after.field - before.field, 1);
     EXPECT_EQ(after.user - before.user, 1);
   }

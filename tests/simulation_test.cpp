@@ -224,7 +224,7 @@ TEST(Simulation, EveryReferenceWorldRunsATenthOfASecondWithItsOwnSettings) {
   for (int i = 0; i < 1000; ++i) ASSERT_TRUE(skewed.step().ok);
 }
 
-// The one table of integrators (src/world/integrator_name.h): every row parses from its name and
+// The one table of integrators (src/world/integrator_table.h): every row parses from its name and
 // its file spelling, has a summary, and the factory builds its class.
 TEST(IntegratorTable, EveryRowParsesBuildsAndNamesItself) {
   ASSERT_FALSE(allIntegrators().empty());

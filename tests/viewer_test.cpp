@@ -324,9 +324,9 @@ TEST(Keys, ToggleTheViewAndReturnTheirCommands) {
 TEST(Keys, NumbersSwitchIntegratorsInRegistryOrder) {
   ViewerState v;
   const auto all = allIntegrators();
-  // 1-9, then 0 for the tenth.
-  ASSERT_EQ(all.size(), 10u);
-  for (std::size_t i = 0; i < all.size(); ++i) {
+  // 1-9, then 0 for the tenth; n reaches the rest.
+  ASSERT_GE(all.size(), 10u);
+  for (std::size_t i = 0; i < 10; ++i) {
     const auto key = static_cast<unsigned char>(i < 9 ? '1' + i : '0');
     const KeyResult r = handleKey(v, key);
     EXPECT_EQ(r.command, Command::SwitchIntegrator) << key;
@@ -334,6 +334,17 @@ TEST(Keys, NumbersSwitchIntegratorsInRegistryOrder) {
   }
   EXPECT_EQ(handleKey(v, '/').command, Command::None);
   EXPECT_EQ(handleKey(v, ':').command, Command::None);
+}
+
+TEST(Keys, NStepsThroughEveryIntegratorAndWrapsAround) {
+  ViewerState v;
+  EXPECT_EQ(handleKey(v, 'n').command, Command::NextIntegrator);
+  const auto all = allIntegrators();
+  IntegratorKind kind = all[0];
+  for (std::size_t i = 1; i <= all.size(); ++i) {
+    kind = nextIntegrator(kind);
+    EXPECT_EQ(kind, all[i % all.size()]);
+  }
 }
 
 TEST(Keys, TimeStepZoomCameraResetAndPullRadius) {
@@ -380,8 +391,8 @@ TEST(Keys, SpeedPanelHelpSaveAndPause) {
 TEST(Keys, TheTableNamesEveryKey) {
   const std::string table = keyTable();
   for (const char* key :
-       {"ESC", "space", "1-9", "+ -", "[ ]", "s h b", " v ", " p ", " r ", " f ",
-        " g ", " e ",   "z x", " i ", " . ", "< >",   " m ", " ? ", " w ", "middle-drag"}) {
+       {"ESC", "space", "1-9", "+ -", "[ ]", "s h b", " v ", " p ", " r ", " f ",        " g ",
+        " e ", "z x",   " n ", " i ", " . ", "< >",   " m ", " ? ", " w ", "middle-drag"}) {
     EXPECT_NE(("\n" + table).find(std::string(key).substr(key[0] == ' ')), std::string::npos)
         << key;
   }

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <span>
+#include <string>
 
 #include "viewer/interaction.h"
 
@@ -21,6 +23,23 @@ constexpr std::array<const char*, 4> kEffortCounters{"newton_iterations", "proje
 
 std::optional<double> statistic(const Frame& frame, const char* name) {
   return findStatistic(frame.solver, name);
+}
+
+// A combo box over one closed set's table; true when another row was chosen.
+template <class Kind, class Name>
+bool tableCombo(const char* label, Kind& value, std::span<const Kind> kinds, Name name) {
+  bool changed = false;
+  if (ImGui::BeginCombo(label, std::string(name(value)).c_str())) {
+    for (Kind kind : kinds) {
+      const bool selected = kind == value;
+      if (ImGui::Selectable(std::string(name(kind)).c_str(), selected) && !selected) {
+        value = kind;
+        changed = true;
+      }
+    }
+    ImGui::EndCombo();
+  }
+  return changed;
 }
 
 // A slider for a positive constant on a logarithmic scale; true when an edit was finished.
@@ -198,22 +217,16 @@ void Panel::solverOptions(const Frame& frame, SimRunner& runner) {
   bool changed = false;
   const auto released = [] { return ImGui::IsItemDeactivatedAfterEdit(); };
   const auto linearSolver = [&](LinearSolverKind& solver, PreconditionerKind& preconditioner) {
-    int k = static_cast<int>(solver);
-    changed |= ImGui::Combo("linear solver", &k, "cholmod\0ldlt\0cg\0");
-    solver = static_cast<LinearSolverKind>(k);
+    changed |= tableCombo("linear solver", solver, allLinearSolvers(), linearSolverName);
     if (solver == LinearSolverKind::Cg) {
-      int p = static_cast<int>(preconditioner);
       changed |=
-          ImGui::Combo("preconditioner", &p, "jacobi\0block-jacobi\0ichol\0factor\0projective\0");
-      preconditioner = static_cast<PreconditionerKind>(p);
+          tableCombo("preconditioner", preconditioner, allPreconditioners(), preconditionerName);
     }
   };
-  switch (frame.integrator) {
-    case IntegratorKind::Implicit:
-    case IntegratorKind::ImplicitLinear:
-    case IntegratorKind::Midpoint:
-    case IntegratorKind::Newmark:
-    case IntegratorKind::Bdf2:
+  // The settings of the integrator's family (src/world/integrator_table.h).
+  switch (integratorFamily(frame.integrator)) {
+    case IntegratorFamily::Newton:
+    case IntegratorFamily::Linearized:
       linearSolver(o.implicit.linearSolver, o.implicit.preconditioner);
       if (logSlider("newton tol", &newtonTolerance_, 1e-12f, 1e-2f, "%.1e")) {
         o.implicit.newtonTolerance = newtonTolerance_;
@@ -232,7 +245,7 @@ void Panel::solverOptions(const Frame& frame, SimRunner& runner) {
       o.implicit.seedChebyshevRho = seedChebyshevRho_;
       changed |= released();
       break;
-    case IntegratorKind::Cvode: {
+    case IntegratorFamily::Cvode: {
       int method = static_cast<int>(o.cvode.method);
       changed |= ImGui::Combo("method", &method, "bdf\0adams\0");
       o.cvode.method = static_cast<CvodeMethod>(method);
@@ -249,14 +262,14 @@ void Panel::solverOptions(const Frame& frame, SimRunner& runner) {
       changed |= ImGui::Checkbox("contact roots", &o.cvode.contactRoots);
       break;
     }
-    case IntegratorKind::Projective:
+    case IntegratorFamily::Projective:
       ImGui::SliderInt("iterations", &o.projective.iterations, 1, 200);
       changed |= released();
       ImGui::SliderFloat("Chebyshev rho", &chebyshevRho_, 0.0f, 0.99f, "%.2f");
       o.projective.chebyshevRho = chebyshevRho_;
       changed |= released();
       break;
-    default:
+    case IntegratorFamily::Explicit:
       ImGui::TextUnformatted("(explicit: no solver settings)");
       return;
   }
@@ -314,16 +327,9 @@ void Panel::build(const Frame& frame, ViewerState& view, SimRunner& runner) {
     ImGui::Begin("panel (m hides)", &view.showPanel);
     ImGui::PushItemWidth(130.0f);
     // Integrator and time step.
-    const auto kinds = allIntegrators();
-    if (ImGui::BeginCombo("integrator", std::string(integratorName(frame.integrator)).c_str())) {
-      for (IntegratorKind kind : kinds) {
-        const bool selected = kind == frame.integrator;
-        if (ImGui::Selectable(std::string(integratorName(kind)).c_str(), selected) && !selected &&
-            !frame.divergence) {
-          runner.post([kind](ViewerSession& s) { s.simulation().setIntegrator(kind); }, true);
-        }
-      }
-      ImGui::EndCombo();
+    IntegratorKind kind = frame.integrator;
+    if (tableCombo("integrator", kind, allIntegrators(), integratorName) && !frame.divergence) {
+      runner.post([kind](ViewerSession& s) { s.simulation().setIntegrator(kind); }, true);
     }
     if (std::abs(dt_ - float(frame.dt)) > 1e-9f * float(frame.dt) && !ImGui::IsAnyItemActive())
       dt_ = static_cast<float>(frame.dt);

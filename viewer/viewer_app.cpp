@@ -17,8 +17,8 @@ namespace window {
 
 std::string Viewer::restartHint() const {
   if (group_) return " - press r to reload the world for every pane";
-  return " - press r to reload the world (then 1-" + std::to_string(allIntegrators().size() % 10) +
-         " picks an integrator, - a smaller time step)";
+  return " - press r to reload the world (then a number key or n picks an integrator, - a "
+         "smaller time step)";
 }
 
 std::string Viewer::hudLine(std::size_t pane) const {

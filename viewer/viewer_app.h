@@ -8,7 +8,7 @@
 #include <optional>
 #include <vector>
 
-#include "src/world/integrator_name.h"
+#include "src/world/integrator_table.h"
 #include "src/world/world.h"
 #include "viewer/camera.h"
 #include "viewer/viewer_session.h"

@@ -44,6 +44,7 @@ void Viewer::key(unsigned char key) {
       break;
     }
     case Command::SwitchIntegrator:
+    case Command::NextIntegrator: {
       if (group_) {
         notify("compare mode: the integrators are the --compare list", true);
         break;
@@ -52,11 +53,12 @@ void Viewer::key(unsigned char key) {
         notify("the simulation diverged" + restartHint(), true);
         break;
       }
-      runner().post(
-          [kind = *result.integrator](ViewerSession& s) { s.simulation().setIntegrator(kind); },
-          true);
-      notify("integrator " + std::string(integratorName(*result.integrator)), false);
+      const IntegratorKind kind =
+          result.integrator ? *result.integrator : nextIntegrator(primary().integrator);
+      runner().post([kind](ViewerSession& s) { s.simulation().setIntegrator(kind); }, true);
+      notify("integrator " + std::string(integratorName(kind)), false);
       break;
+    }
     case Command::TimeStep:
       postAll([scale = view_.dtScale](ViewerSession& s) { s.scaleTimeStep(scale); }, true);
       notify("time step x" + format("%.4g", view_.dtScale) + " of the world's", false);

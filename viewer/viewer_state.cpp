@@ -12,13 +12,7 @@ namespace jello::viewer {
 
 KeyResult handleKey(ViewerState& s, unsigned char key) {
   const auto integrators = allIntegrators();
-  // Keys 1-9, then 0 for the tenth.
-  static_assert(std::size(std::array{
-#define JELLO_INTEGRATOR_ROW(kind, name, fileName, Class, summary) 0,
-                    JELLO_INTEGRATORS(JELLO_INTEGRATOR_ROW)
-#undef JELLO_INTEGRATOR_ROW
-                }) <= 10,
-                "the number keys reach ten integrators");
+  // Keys 1-9, then 0 for the tenth; n steps through all of them (and the panel lists them).
   const std::size_t index = key == '0' ? 9 : static_cast<std::size_t>(key - '1');
   if (key >= '0' && key <= '9' && index < integrators.size()) {
     return {Command::SwitchIntegrator, integrators[index]};
@@ -30,6 +24,8 @@ KeyResult handleKey(ViewerState& s, unsigned char key) {
       return {Command::Screenshot, {}};
     case 'r':
       return {Command::Reload, {}};
+    case 'n':
+      return {Command::NextIntegrator, {}};
     case 'e':
       s.camera = Camera{};
       break;
@@ -101,13 +97,20 @@ KeyResult handleKey(ViewerState& s, unsigned char key) {
   return {};
 }
 
+IntegratorKind nextIntegrator(IntegratorKind kind) {
+  const auto all = allIntegrators();
+  const auto at = std::find(all.begin(), all.end(), kind);
+  return at == all.end() || at + 1 == all.end() ? all.front() : *(at + 1);
+}
+
 namespace {
 
-// "1-5", "integrator: 1 euler, 2 symplectic, ... (same state)", from the integrator table.
+// "1-9, 0", "integrator: 1 euler, 2 symplectic, ... (same state)", from the integrator table:
+// the first ten have a number key each, n steps through all.
 KeyBinding integratorKeys() {
   const auto integrators = allIntegrators();
   std::string action = "integrator:";
-  for (std::size_t i = 0; i < integrators.size(); ++i) {
+  for (std::size_t i = 0; i < std::min<std::size_t>(integrators.size(), 10); ++i) {
     action += (i ? ", " : " ") + std::to_string((i + 1) % 10) + " " +
               std::string(integratorName(integrators[i]));
   }
@@ -135,6 +138,7 @@ std::span<const KeyBinding> keyBindings() {
       {".", "advance one frame (the world's n*dt) while paused"},
       {"< >", "playback speed /2, x2 (simulated seconds per wall second)"},
       integratorKeys(),
+      {"n", "next integrator in the table (all of them; the panel lists them too)"},
       {"+ -", "time step x2, /2 (playback speed unchanged)"},
       {"r", "reload the world file (a bad file keeps the running scene)"},
       {"f", "force-field arrows on/off"},

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "src/world/integrator_name.h"
+#include "src/world/integrator_table.h"
 #include "viewer/camera.h"
 
 namespace jello::viewer {
@@ -39,7 +39,8 @@ enum class Command {
   Quit,              // ESC
   Screenshot,        // space
   Reload,            // r: read the world file again
-  SwitchIntegrator,  // 1-5: see KeyResult::integrator
+  SwitchIntegrator,  // 1-9, 0: see KeyResult::integrator
+  NextIntegrator,    // n: the one after the current in the table, cyclically
   TimeStep,          // + / -: dtScale changed
   StepOnce,          // . : one frame while paused
   Pause,             // p: paused changed
@@ -54,6 +55,9 @@ struct KeyResult {
 
 // Applies key `key` to the state; unknown keys do nothing.
 KeyResult handleKey(ViewerState& state, unsigned char key);
+
+// The integrator after `kind` in the table, the first after the last (key n).
+IntegratorKind nextIntegrator(IntegratorKind kind);
 
 struct KeyBinding {
   std::string keys;

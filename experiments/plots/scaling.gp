@@ -14,21 +14,26 @@ set key outside right top
 set xlabel 'cube resolution N (N^3 points)'
 set ylabel 'wall seconds per simulated second'
 sel(integ, solver) = sprintf("< awk -F, '$4==\"%s\" && $5==\"%s\"' %s | sort -t, -k1,1n", integ, solver, csv)
+load 'experiments/plots/integrators.gp'
+# The (integrator, linear solver) pairs the CSV holds, in its order: explicit ones with "none".
+pairs = system("awk -F, 'NR > 1 && !seen[$4 \",\" $5]++ { printf \"%s,%s \", $4, $5 }' ".csv)
+pinteg(p) = p[1:strstrt(p, ',') - 1]
+psolver(p) = p[strstrt(p, ',') + 1:]
+plabel(p) = psolver(p) eq 'none' ? pinteg(p) : pinteg(p).', '.(psolver(p) eq 'cholmod' ? 'CHOLMOD' : psolver(p) eq 'cg' ? 'CG' : psolver(p))
+# The first solver of an integrator in its colour, the next in its variant colour.
+pfirst(p, i) = i == 1 ? 1 : pinteg(word(pairs, i - 1)) ne pinteg(p)
+pcolour(p, i) = pfirst(p, i) ? colour(pinteg(p)) : variant_colour(pinteg(p))
+# The first implicit pair with a factorization's share (its CHOLMOD run): its parts dashed.
+split = system("awk -F, 'NR > 1 && $5 == \"cholmod\" { print $4 \",\" $5; exit }' ".csv)
 set xtics (6, 8, 12, 16, 24, 32)
 set xrange [5.5:36]
 do for [fmt in (atlas_only ? "" : "pngcairo svg")] {
   if (fmt eq "pngcairo") { set terminal pngcairo size 900,560 font ",10"; set output dir.'/scaling.png' } \
   else { set terminal svg size 900,560 font ",10"; set output dir.'/scaling.svg' }
   set title 'Cost against cube size (k = 10^4; explicit at 0.9 of their limit, implicit dt 0.01, cvode rtol 1e-3)'
-  plot sel('euler','none') using 1:12 with linespoints pt 7 lw 2 lc rgb '#d62728' title 'euler', \
-       sel('symplectic','none') using 1:12 with linespoints pt 7 lw 2 lc rgb '#2ca02c' title 'symplectic', \
-       sel('rk4','none') using 1:12 with linespoints pt 7 lw 2 lc rgb '#1f77b4' title 'rk4', \
-       sel('implicit','cholmod') using 1:12 with linespoints pt 5 lw 2 lc rgb '#9467bd' title 'implicit, CHOLMOD', \
-       sel('implicit','cholmod') using 1:14 with linespoints pt 4 dt 2 lc rgb '#9467bd' title '  its factorizations', \
-       sel('implicit','cholmod') using 1:15 with linespoints pt 6 dt 3 lc rgb '#9467bd' title '  its solves', \
-       sel('implicit','cg') using 1:12 with linespoints pt 9 lw 2 lc rgb '#8c564b' title 'implicit, CG', \
-       sel('cvode','cholmod') using 1:12 with linespoints pt 11 lw 2 lc rgb '#ff7f0e' title 'cvode, CHOLMOD', \
-       sel('cvode','cg') using 1:12 with linespoints pt 13 lw 2 lc rgb '#e377c2' title 'cvode, CG'
+  plot for [i=1:words(pairs)] sel(pinteg(word(pairs,i)), psolver(word(pairs,i))) using 1:12 with linespoints pt pointtype(pinteg(word(pairs,i))) lw 2 lc rgb pcolour(word(pairs,i), i) title plabel(word(pairs,i)), \
+       sel(pinteg(split), psolver(split)) using 1:14 with linespoints pt 4 dt 2 lc rgb colour(pinteg(split)) title '  its factorizations', \
+       sel(pinteg(split), psolver(split)) using 1:15 with linespoints pt 6 dt 3 lc rgb colour(pinteg(split)) title '  its solves'
   set output
 }
 
@@ -37,9 +42,6 @@ do for [fmt in (atlas_only ? "" : "pngcairo svg")] {
 atlases = dir.'/*_atlas.csv'
 if (!exists("atlas_ns")) atlas_ns = '8'
 asel(n, integ) = sprintf("< awk -F, '$2==\"%s\" && $4==\"%s\" && $11==\"ok\"' %s | sort -t, -k1,1g", n, integ, atlases)
-aintegrators = "euler symplectic rk4 implicit implicit-linear midpoint newmark bdf2 projective cvode"
-acolors = "#d62728 #2ca02c #1f77b4 #9467bd #c5b0d5 #17becf #bcbd22 #e377c2 #7f7f7f #ff7f0e"
-apoints = "7 7 7 5 5 9 9 11 13 15"
 unset xtics
 set xtics auto
 set xrange [*:*]
@@ -51,7 +53,7 @@ do for [n in atlas_ns] {
     if (fmt eq "pngcairo") { set terminal pngcairo size 900,560 font ",10"; set output dir.'/atlas_n'.n.'.png' } \
     else { set terminal svg size 900,560 font ",10"; set output dir.'/atlas_n'.n.'.svg' }
     set title 'Crossover atlas'.scene.', N = '.n.': cost at the largest step keeping the visible motion within 1 cm'."\n".'(a missing point: not reached)'
-    plot for [i=1:10] asel(n, word(aintegrators,i)) using 1:8 with linespoints pt (word(apoints,i)+0) lw 2 lc rgb word(acolors,i) title word(aintegrators,i)
+    plot for [i=1:words(integrators)] asel(n, word(integrators,i)) using 1:8 with linespoints pt pointtype(word(integrators,i)) lw 2 lc rgb colour(word(integrators,i)) title word(integrators,i)
     set output
   }
 }
@@ -59,10 +61,8 @@ do for [n in atlas_ns] {
 # The region chart: at each (k, N) run, the cheapest integrator keeping the visible motion, with
 # its cost; "none" where no integrator did within the run budget.
 region = "< awk -F, 'FNR > 1 { key = $1 \" \" $2; seen[key] = 1 } FNR > 1 && $11 == \"ok\" { key = $1 \" \" $2; if (!(key in best) || $8 + 0 < best[key]) { best[key] = $8 + 0; who[key] = $4 } } END { for (key in seen) print key, (key in best ? who[key] \" \" best[key] : \"none nan\") }' ".atlases
-acolor(s) = s eq 'euler' ? 0xd62728 : s eq 'symplectic' ? 0x2ca02c : s eq 'rk4' ? 0x1f77b4 : \
-  s eq 'implicit' ? 0x9467bd : s eq 'implicit-linear' ? 0xc5b0d5 : s eq 'midpoint' ? 0x17becf : \
-  s eq 'newmark' ? 0xbcbd22 : s eq 'bdf2' ? 0xe377c2 : s eq 'projective' ? 0x7f7f7f : \
-  s eq 'cvode' ? 0xff7f0e : 0xdddddd
+# A colour as a number, for `lc rgb variable`: grey where no integrator kept the motion.
+acolor(s) = rowof(s, 1) == 0 ? 0xdddddd : int('0x'.colour(s)[2:])
 cost(t) = t < 1 ? sprintf('%.3g ms', 1e3 * t) : sprintf('%.3g s', t)
 set datafile separator whitespace
 set logscale x
@@ -79,6 +79,6 @@ do for [fmt in (atlas_only ? "" : "pngcairo svg")] {
   set title 'Crossover atlas: the cheapest integrator keeping the visible motion within 1 cm, and its wall time per simulated second'
   plot region using 1:2:(acolor(strcol(3))) with points pt 5 ps 7 lc rgb variable notitle, \
        region using 1:2:(strcol(3) eq 'none' ? "none within\nthe budget" : strcol(3)."\n".cost(column(4))) with labels font ",8" notitle, \
-       for [i=1:10] NaN with points pt 5 ps 2 lc rgb word(acolors,i) title word(aintegrators,i)
+       for [i=1:words(integrators)] NaN with points pt 5 ps 2 lc rgb colour(word(integrators,i)) title word(integrators,i)
   set output
 }

@@ -12,8 +12,11 @@ set grid
 set key below maxrows 3
 set xlabel 'spring stiffness k (N/m)'
 sel(scene, integ, src) = sprintf("< awk -F, '$1==\"%s\" && $2==\"%s\" && $7==\"%s\"' %s", scene, integ, src, csv)
-integrators = "euler symplectic rk4 implicit cvode"
-colors = "#d62728 #2ca02c #1f77b4 #9467bd #ff7f0e"
+load 'experiments/plots/integrators.gp'
+nexplicit = words(explicit_integrators)
+# The methods without a predicted limit: every other row, drawn only where the CSV has them.
+others = ''
+do for [i=1:words(integrators)] { name = word(integrators, i); if (strstrt(' '.explicit_integrators.' ', ' '.name.' ') == 0) { others = others.' '.name } }
 
 do for [scene in scenes] {
   do for [fmt in "pngcairo svg"] {
@@ -22,11 +25,10 @@ do for [scene in scenes] {
     set title 'Largest stable time step, '.scene.' scene (points measured, lines predicted)'
     set ylabel 'dt (s)'
     set yrange [1e-6:0.1]
-    plot for [i=1:3] sel(scene, word(integrators,i), 'predicted') using 3:8 with lines lw 2 lc rgb word(colors,i) title word(integrators,i).' predicted', \
-         for [i=1:3] sel(scene, word(integrators,i), 'measured') using 3:8 with points pt 7 ps 1.1 lc rgb word(colors,i) title word(integrators,i).' measured', \
-         sel(scene, 'implicit', 'measured') using 3:8 with points pt 4 ps 2.2 lw 2 lc rgb word(colors,4) title 'implicit: stable at the largest dt tried', \
-         sel(scene, 'cvode', 'measured') using 3:8 with points pt 7 ps 0.9 lc rgb word(colors,5) title 'cvode: stable at the largest dt tried', \
-         sel(scene, 'rk4', 'measured') using 3:(1/$5) with lines dt 2 lc rgb 'black' title 'Courant number 1: dt = 1/w_{max} (w_{max} of the scene, from the CSV)'
+    plot for [i=1:nexplicit] sel(scene, word(explicit_integrators,i), 'predicted') using 3:8 with lines lw 2 lc rgb colour(word(explicit_integrators,i)) title word(explicit_integrators,i).' predicted', \
+         for [i=1:nexplicit] sel(scene, word(explicit_integrators,i), 'measured') using 3:8 with points pt 7 ps 1.1 lc rgb colour(word(explicit_integrators,i)) title word(explicit_integrators,i).' measured', \
+         for [i=1:words(others)] sel(scene, word(others,i), 'measured') using 3:8 with points pt (i == 1 ? 4 : 6 + i) ps (2.4 - 0.15 * i) lw 2 lc rgb colour(word(others,i)) title word(others,i).': largest stable dt found', \
+         sel(scene, word(explicit_integrators,1), 'measured') using 3:(1/$5) with lines dt 2 lc rgb 'black' title 'Courant number 1: dt = 1/w_{max} (w_{max} of the scene, from the CSV)'
     set output
   }
   do for [fmt in "pngcairo svg"] {
@@ -35,8 +37,8 @@ do for [scene in scenes] {
     set title 'Thresholds in Courant numbers h w_{max}, '.scene.' scene'
     set ylabel 'h w_{max}'
     set yrange [0.005:10]
-    plot for [i=1:3] sel(scene, word(integrators,i), 'predicted') using 3:9 with lines lw 2 lc rgb word(colors,i) title word(integrators,i).' predicted', \
-         for [i=1:3] sel(scene, word(integrators,i), 'measured') using 3:9 with points pt 7 ps 1.1 lc rgb word(colors,i) title word(integrators,i).' measured', \
+    plot for [i=1:nexplicit] sel(scene, word(explicit_integrators,i), 'predicted') using 3:9 with lines lw 2 lc rgb colour(word(explicit_integrators,i)) title word(explicit_integrators,i).' predicted', \
+         for [i=1:nexplicit] sel(scene, word(explicit_integrators,i), 'measured') using 3:9 with points pt 7 ps 1.1 lc rgb colour(word(explicit_integrators,i)) title word(explicit_integrators,i).' measured', \
          1 with lines dt 2 lc rgb 'black' title 'Courant number 1: dt = 1/w_{max}'
     set output
   }

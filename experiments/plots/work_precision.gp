@@ -12,9 +12,11 @@ set logscale xy
 set grid
 set key outside right top
 sel(scene, integ, method) = sprintf("< awk -F, '$1==\"%s\" && $2==\"%s\" && $3==\"%s\" && $22==\"ok\"' %s | sort -t, -k4,4g -k5,5g", scene, integ, method, csv)
-integrators = "euler symplectic rk4 implicit implicit-linear midpoint newmark bdf2 projective"
-colors = "#d62728 #2ca02c #1f77b4 #9467bd #c5b0d5 #17becf #bcbd22 #e377c2 #7f7f7f"
-points = "7 7 7 5 5 9 9 11 13"
+load 'experiments/plots/integrators.gp'
+# Adaptive integrators (CVODE) run each of its methods: a line per method, in the variant colour.
+adaptive = ''
+do for [i=1:words(integrators)] { name = word(integrators, i); if (strstrt(' '.fixed_step_integrators.' ', ' '.name.' ') == 0) { adaptive = adaptive.' '.name } }
+nfixed = words(fixed_step_integrators)
 
 do for [scene in scenes] {
   do for [q in "position energy"] {
@@ -25,9 +27,9 @@ do for [scene in scenes] {
       set title 'Work-precision, '.scene.' scene: '.(q eq "position" ? 'largest position error over the window (m)' : 'largest energy error over the window, relative to E(0)')
       set xlabel 'wall time of the steps (s; median, bars: min to max of the repeats)'
       set ylabel (q eq "position" ? 'max_t max_i |x_i - x_{ref}| (m)' : 'max_t |E - E_{ref}| / E_{ref}(0)')
-      plot for [i=1:9] sel(scene, word(integrators,i), 'none') using 10:col:11:12 with xerrorlines pt (word(points,i)+0) lw 2 lc rgb word(colors,i) title word(integrators,i), \
-           sel(scene, 'cvode', 'bdf') using 10:col:11:12 with xerrorlines pt 5 lw 2 lc rgb '#ff7f0e' title 'cvode, BDF', \
-           sel(scene, 'cvode', 'adams') using 10:col:11:12 with xerrorlines pt 9 lw 2 lc rgb '#8c564b' title 'cvode, Adams'
+      plot for [i=1:nfixed] sel(scene, word(fixed_step_integrators,i), 'none') using 10:col:11:12 with xerrorlines pt pointtype(word(fixed_step_integrators,i)) lw 2 lc rgb colour(word(fixed_step_integrators,i)) title word(fixed_step_integrators,i), \
+           for [i=1:words(adaptive)] sel(scene, word(adaptive,i), 'bdf') using 10:col:11:12 with xerrorlines pt 5 lw 2 lc rgb colour(word(adaptive,i)) title word(adaptive,i).', BDF', \
+           for [i=1:words(adaptive)] sel(scene, word(adaptive,i), 'adams') using 10:col:11:12 with xerrorlines pt 9 lw 2 lc rgb variant_colour(word(adaptive,i)) title word(adaptive,i).', Adams'
       set output
     }
   }
@@ -45,11 +47,10 @@ do for [fmt in "pngcairo svg"] {
   set format x '10^{%L}'
   set key inside right top
   dmp(integ) = sprintf("< awk -F, '$2==\"%s\"' %s | sort -t, -k3,3g", integ, damping)
-  plot dmp('implicit') using 3:12 with lines lw 2 lc rgb '#9467bd' title 'implicit, theory', \
-       dmp('implicit') using 3:9 with points pt 7 ps 1.2 lc rgb '#9467bd' title 'implicit, measured', \
-       dmp('bdf2') using 3:12 with lines lw 2 lc rgb '#e377c2' title 'bdf2, theory', \
-       dmp('bdf2') using 3:9 with points pt 11 ps 1.2 lc rgb '#e377c2' title 'bdf2, measured', \
-       dmp('midpoint') using 3:9 with points pt 9 ps 1.2 lc rgb '#17becf' title 'midpoint, measured (theory: 0)'
+  # The integrators the CSV holds (one per A-stable linear model), in its order.
+  damped = system("awk -F, 'NR > 1 && !seen[$2]++ { printf \"%s \", $2 }' ".damping)
+  plot for [i=1:words(damped)] dmp(word(damped,i)) using 3:12 with lines lw 2 lc rgb colour(word(damped,i)) title word(damped,i).', theory', \
+       for [i=1:words(damped)] dmp(word(damped,i)) using 3:9 with points pt pointtype(word(damped,i)) ps 1.2 lc rgb colour(word(damped,i)) title word(damped,i).', measured'
   set output
   set format x
 }
@@ -70,10 +71,10 @@ do for [fmt in "pngcairo svg"] {
   set xlabel 't (s)'
   set ylabel 'total energy E(t) / E(0)'
   set yrange [1e-6:10]
-  plot for [i=1:9] dsel(word(integrators,i)) using 3:5 with lines lw 2 lc rgb word(colors,i) title word(integrators,i)
+  plot for [i=1:nfixed] dsel(word(fixed_step_integrators,i)) using 3:5 with lines lw 2 lc rgb colour(word(fixed_step_integrators,i)) title word(fixed_step_integrators,i)
   set ylabel '|L(t) - L(0)| / |L(0)|'
   set yrange [1e-16:10]
-  plot for [i=1:9] dsel(word(integrators,i)) using 3:($6 > 0 ? $6 : 1/0) with lines lw 2 lc rgb word(colors,i) title word(integrators,i)
+  plot for [i=1:nfixed] dsel(word(fixed_step_integrators,i)) using 3:($6 > 0 ? $6 : 1/0) with lines lw 2 lc rgb colour(word(fixed_step_integrators,i)) title word(fixed_step_integrators,i)
   set format y
   unset multiplot
   set output

@@ -26,7 +26,12 @@ import jello  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 COMMITTED = os.path.join(ROOT, "experiments", "results", "stability.csv")
-COLORS = {"euler": "#d62728", "symplectic": "#2ca02c", "rk4": "#1f77b4"}
+# The explicit rows of the integrator table (those with a stability limit), each in the colour
+# of its row in the charts (experiments/plots/integrators.gp).
+PALETTE = ["#d62728", "#2ca02c", "#1f77b4", "#9467bd", "#ff7f0e", "#c5b0d5", "#17becf",
+           "#bcbd22", "#e377c2", "#7f7f7f", "#8c564b", "#aec7e8", "#98df8a", "#ffbb78"]
+COLORS = {r["name"]: PALETTE[i % len(PALETTE)] for i, r in enumerate(jello.integrator_table())}
+EXPLICIT = [r["name"] for r in jello.integrator_table() if r["explicit"]]
 DAMPING_RATIO = 1e-5  # s, c/k: jello-stability's default
 
 
@@ -45,7 +50,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--k", help="stiffnesses, N/m, comma-separated (default 10 to 1e6, "
                         "two per decade; --quick: 1e2, 1e4)")
-    parser.add_argument("--integrators", default="euler,symplectic,rk4")
+    parser.add_argument("--integrators", default=",".join(EXPLICIT))
     parser.add_argument("--quick", action="store_true", help="two stiffnesses, seconds")
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
     parser.add_argument("--out", default="stability_free_python.png", help="chart (PNG or SVG)")

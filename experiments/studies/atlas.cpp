@@ -8,10 +8,11 @@
 
 #include "experiments/studies/reference_file.h"
 #include "experiments/studies/stability_analysis.h"
+#include "experiments/studies/study_integrators.h"
 #include "experiments/studies/trajectory_run.h"
 #include "solvers/simulation.h"
 #include "src/base/parallel.h"
-#include "src/world/integrator_name.h"
+#include "src/world/integrator_table.h"
 #include "src/world/lattice.h"
 #include "src/world/scene_builder.h"
 
@@ -221,14 +222,7 @@ AtlasReference atlasReference(const World& w, double k, AtlasScene scene, const 
 }
 
 std::vector<IntegratorKind> atlasIntegrators(bool quick) {
-  if (quick) {
-    return {IntegratorKind::Symplectic, IntegratorKind::RK4, IntegratorKind::Implicit,
-            IntegratorKind::Midpoint, IntegratorKind::Projective};
-  }
-  return {IntegratorKind::Euler,    IntegratorKind::Symplectic,     IntegratorKind::RK4,
-          IntegratorKind::Implicit, IntegratorKind::ImplicitLinear, IntegratorKind::Midpoint,
-          IntegratorKind::Newmark,  IntegratorKind::Bdf2,           IntegratorKind::Projective,
-          IntegratorKind::Cvode};
+  return quick ? quickAtlasIntegrators() : studyOrder();
 }
 
 CsvTable atlasTable() {
@@ -245,7 +239,7 @@ void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const Atla
   // The candidates, largest first: explicit steps from 0.9 of the predicted limit (dividing the
   // sample interval), the others from the interval; cvode's tolerances from 1e-2.
   std::vector<double> steps, rtols;
-  if (kind == IntegratorKind::Cvode) {
+  if (isAdaptive(kind)) {
     for (int j = 0; j < setup.halvings; ++j) rtols.push_back(std::pow(10.0, -2 - j));
   } else {
     double dt = setup.interval;
@@ -260,19 +254,19 @@ void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const Atla
     }
     for (int j = 0; j < setup.halvings; ++j, dt /= 2.0) steps.push_back(dt);
   }
-  const std::size_t count = kind == IntegratorKind::Cvode ? rtols.size() : steps.size();
+  const std::size_t count = isAdaptive(kind) ? rtols.size() : steps.size();
   long tried = 0;
   double lastWall = 0.0, lastError = nan;
   std::string outcome = "not_reached";
   for (std::size_t i = 0; i < count; ++i) {
     // Halving the step doubles the cost: a run that would exceed the budget is not started.
-    if (kind != IntegratorKind::Cvode && 2.0 * lastWall * setup.time > setup.runBudget) {
+    if (!isAdaptive(kind) && 2.0 * lastWall * setup.time > setup.runBudget) {
       outcome = "budget";
       break;
     }
     SolverOptions options;
-    double dt = kind == IntegratorKind::Cvode ? setup.interval : steps[i];
-    if (kind == IntegratorKind::Cvode) {
+    double dt = isAdaptive(kind) ? setup.interval : steps[i];
+    if (isAdaptive(kind)) {
       options.cvode.rtol = rtols[i];
       options.cvode.maxStepsPerCall = 100000000;
     }
@@ -286,8 +280,8 @@ void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const Atla
     lastError = a.finished ? a.error : nan;
     if (a.finished && a.error <= setup.tolerance) {
       table.add({k, long(n), wMax, std::string(integratorName(kind)), dt,
-                 kind == IntegratorKind::Cvode ? rtols[i] : nan, a.steps, a.wallPerSecond, a.error,
-                 tried, std::string("ok"), ref.dt, ref.check});
+                 isAdaptive(kind) ? rtols[i] : nan, a.steps, a.wallPerSecond, a.error, tried,
+                 std::string("ok"), ref.dt, ref.check});
       return;
     }
   }

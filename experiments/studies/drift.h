@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "experiments/studies/csv_table.h"
-#include "src/world/integrator_name.h"
+#include "src/world/integrator_table.h"
 #include "src/world/world.h"
 
 namespace jello::experiments {

@@ -54,17 +54,7 @@ ModalDecomposition decomposeOnRestModes(const World& world) {
 }
 
 bool hasModalTheory(IntegratorKind kind) {
-  switch (kind) {
-    case IntegratorKind::Implicit:
-    case IntegratorKind::ImplicitLinear:
-    case IntegratorKind::Projective:
-    case IntegratorKind::Bdf2:
-    case IntegratorKind::Midpoint:
-    case IntegratorKind::Newmark:
-      return true;
-    default:
-      return false;
-  }
+  return isAStable(linearModel(kind));
 }
 
 double predictedEnergy(const ModalDecomposition& modes, IntegratorKind kind, double dt,
@@ -73,8 +63,9 @@ double predictedEnergy(const ModalDecomposition& modes, IntegratorKind kind, dou
     throw std::invalid_argument("modal theory: no linear map for " +
                                 std::string(integratorName(kind)));
   }
-  const bool bdf2 = kind == IntegratorKind::Bdf2;
-  const bool trapezoidal = kind == IntegratorKind::Midpoint || kind == IntegratorKind::Newmark;
+  const LinearModel model = linearModel(kind);
+  const bool bdf2 = model == LinearModel::Bdf2;
+  const bool trapezoidal = model == LinearModel::Trapezoidal;
   double energy = 0.0;
   for (Eigen::Index j = 0; j < modes.omega.size(); ++j) {
     const double w = modes.omega[j];

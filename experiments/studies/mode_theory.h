@@ -15,7 +15,7 @@
 
 #include <Eigen/Core>
 
-#include "src/world/integrator_name.h"
+#include "src/world/integrator_table.h"
 #include "src/world/world.h"
 
 namespace jello::experiments {

@@ -20,6 +20,7 @@
 #include "experiments/studies/ranks.h"
 #include "experiments/studies/run_context.h"
 #include "experiments/studies/stability_analysis.h"
+#include "experiments/studies/study_integrators.h"
 #include "solvers/linalg/solver_threads.h"
 #include "solvers/simulation.h"
 #include "src/base/finite_options.h"
@@ -171,14 +172,12 @@ int main(int argc, char** argv) {
 
   std::vector<Task> tasks;
   for (int n : ns) {
-    for (IntegratorKind kind :
-         {IntegratorKind::Euler, IntegratorKind::Symplectic, IntegratorKind::RK4}) {
+    for (IntegratorKind kind : integratorsOf({IntegratorFamily::Explicit})) {
       tasks.push_back({n, kind});
     }
-    for (IntegratorKind kind : {IntegratorKind::Implicit, IntegratorKind::Cvode}) {
+    for (IntegratorKind kind : scalingImplicitIntegrators()) {
       for (LinearSolverKind solver : {LinearSolverKind::Cholmod, LinearSolverKind::Cg}) {
-        if (kind == IntegratorKind::Cvode && solver == LinearSolverKind::Cholmod &&
-            n > cvodeDirectMaxN) {
+        if (isAdaptive(kind) && solver == LinearSolverKind::Cholmod && n > cvodeDirectMaxN) {
           continue;
         }
         tasks.push_back({n, kind, solver});
@@ -213,9 +212,7 @@ int main(int argc, char** argv) {
         const double wMax = maxAngularFrequency(Model(w), initialState(w));
         const double damping = w.kElastic > 0.0 ? w.dElastic / w.kElastic : 0.0;
         double dt = implicitDt;
-        if (t.kind != IntegratorKind::Implicit && t.kind != IntegratorKind::Cvode) {
-          dt = 0.9 * predictedThreshold(t.kind, wMax, damping);
-        }
+        if (isExplicit(t.kind)) dt = 0.9 * predictedThreshold(t.kind, wMax, damping);
         SolverOptions options;
         options.implicit.linearSolver = options.cvode.linearSolver = t.solver;
         options.cvode.rtol = rtol;
@@ -229,7 +226,7 @@ int main(int argc, char** argv) {
         }
         const double simulated = sim.state().t;
         const Integrator& integ = sim.integrator();
-        const bool split = t.kind == IntegratorKind::Implicit || t.kind == IntegratorKind::Cvode;
+        const bool split = !isExplicit(t.kind);
         const auto perSecond = [&](const char* stat) {
           return split ? findStatistic(integ.statistics(), stat).value_or(std::nan("")) / simulated
                        : std::nan("");

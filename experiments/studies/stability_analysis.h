@@ -21,7 +21,7 @@
 #include "experiments/common/modes.h"
 #include "solvers/solver_options.h"
 #include "src/model.h"
-#include "src/world/integrator_name.h"
+#include "src/world/integrator_table.h"
 #include "src/world/world.h"
 
 namespace jello::experiments {

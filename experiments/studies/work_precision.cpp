@@ -23,6 +23,7 @@
 #include "experiments/studies/ranks.h"
 #include "experiments/studies/run_context.h"
 #include "experiments/studies/stability_analysis.h"
+#include "experiments/studies/study_integrators.h"
 #include "experiments/studies/trajectory_run.h"
 #include "solvers/linalg/solver_threads.h"
 #include "solvers/simulation.h"
@@ -60,10 +61,6 @@ struct Task {
   CvodeMethod method = CvodeMethod::Bdf;
   double rtol = 0.0;  // cvode only
 };
-
-constexpr IntegratorKind kImplicitKinds[] = {
-    IntegratorKind::Implicit, IntegratorKind::ImplicitLinear, IntegratorKind::Midpoint,
-    IntegratorKind::Newmark,  IntegratorKind::Bdf2,           IntegratorKind::Projective};
 
 }  // namespace
 
@@ -190,30 +187,33 @@ int main(int argc, char** argv) {
   std::vector<Task> tasks;
   for (std::size_t s = 0; s < scenes.size(); ++s) {
     const Scene& scene = scenes[s];
-    for (IntegratorKind kind :
-         {IntegratorKind::Euler, IntegratorKind::Symplectic, IntegratorKind::RK4}) {
-      // The largest step: the largest interval / 2^j below 0.9 of the predicted limit. --quick
-      // starts the first-order methods where h w_max <= 0.5, in the asymptotic range where
-      // their order shows, and keeps the runs short.
-      double limit = 0.9 * predictedThreshold(kind, scene.wMax, scene.dampingRatio);
-      if (limit <= 0.0) continue;  // forward Euler on an undamped scene: never stable
-      if (quick && kind != IntegratorKind::RK4) limit = std::min(limit, 0.5 / scene.wMax);
-      double dt = interval;
-      while (dt > limit) dt /= 2.0;
-      for (int l = 0; l < levels; ++l, dt /= 2.0) tasks.push_back({s, kind, dt});
-    }
-    for (IntegratorKind kind : kImplicitKinds) {
-      if (quick && kind != IntegratorKind::Implicit) continue;
-      // From the sampling interval (quick: from h w_max <= 0.5, where order 1 shows).
-      double dt = interval;
-      if (quick) {
-        while (dt * scene.wMax > 0.5) dt /= 2.0;
+    for (IntegratorKind kind : studyOrder()) {
+      if (isAdaptive(kind)) {
+        for (CvodeMethod method : {CvodeMethod::Bdf, CvodeMethod::Adams}) {
+          if (quick && method == CvodeMethod::Adams) continue;
+          for (double rtol : rtols) tasks.push_back({s, kind, interval, method, rtol});
+        }
+      } else if (isExplicit(kind)) {
+        // The largest step: the largest interval / 2^j below 0.9 of the predicted limit.
+        // --quick starts the first-order methods where h w_max <= 0.5, in the asymptotic range
+        // where their order shows, and keeps the runs short.
+        double limit = 0.9 * predictedThreshold(kind, scene.wMax, scene.dampingRatio);
+        if (limit <= 0.0) continue;  // forward Euler on an undamped scene: never stable
+        if (quick && linearModel(kind) != LinearModel::RungeKutta4) {
+          limit = std::min(limit, 0.5 / scene.wMax);
+        }
+        double dt = interval;
+        while (dt > limit) dt /= 2.0;
+        for (int l = 0; l < levels; ++l, dt /= 2.0) tasks.push_back({s, kind, dt});
+      } else {
+        if (quick && kind != kQuickImplicit) continue;
+        // From the sampling interval (quick: from h w_max <= 0.5, where order 1 shows).
+        double dt = interval;
+        if (quick) {
+          while (dt * scene.wMax > 0.5) dt /= 2.0;
+        }
+        for (int l = 0; l < levels; ++l, dt /= 2.0) tasks.push_back({s, kind, dt});
       }
-      for (int l = 0; l < levels; ++l, dt /= 2.0) tasks.push_back({s, kind, dt});
-    }
-    for (CvodeMethod method : {CvodeMethod::Bdf, CvodeMethod::Adams}) {
-      if (quick && method == CvodeMethod::Adams) continue;
-      for (double rtol : rtols) tasks.push_back({s, IntegratorKind::Cvode, interval, method, rtol});
     }
   }
   // Artificial damping: the stiff cube without any damping (and without spin, so all its energy
@@ -223,8 +223,7 @@ int main(int argc, char** argv) {
   const World undamped = spinningStiffCube(stiffK, 0.0, 0.0);
   const double dampingTime = 0.02;
   std::vector<std::pair<IntegratorKind, double>> dampingRuns;
-  for (IntegratorKind kind :
-       {IntegratorKind::Implicit, IntegratorKind::Bdf2, IntegratorKind::Midpoint}) {
+  for (IntegratorKind kind : dampingRepresentatives()) {
     double dt = 0.01;
     for (int l = 0; l < (quick ? 2 : 8); ++l, dt /= 2.0) dampingRuns.emplace_back(kind, dt);
   }
@@ -298,7 +297,7 @@ int main(int argc, char** argv) {
         const Task& t = tasks[static_cast<std::size_t>(i)];
         const Scene& s = scenes[t.scene];
         SolverOptions options;
-        const bool cvode = t.kind == IntegratorKind::Cvode;
+        const bool cvode = isAdaptive(t.kind);
         if (cvode) {
           options.cvode.method = t.method;
           options.cvode.rtol = t.rtol;

@@ -159,7 +159,8 @@ int run(const Options& opt) {
                    *opt.time, dt, total, end, end - asked);
     }
   }
-  if (sim.integratorKind() == jello::IntegratorKind::Cvode && !opt.quiet) {
+  if (jello::integratorFamily(sim.integratorKind()) == jello::IntegratorFamily::Cvode &&
+      !opt.quiet) {
     warnOfLightlyDampedStiffness(sim, opt.steps ? double(total) * dt : opt.time.value_or(1.0),
                                  kElastic, dElastic);
   }

@@ -1,15 +1,44 @@
 #include "experiments/tools/solver_flags.h"
 
+#include <span>
+#include <vector>
+
 #include "solvers/linalg/linear_solver.h"
+#include "src/base/closed_set.h"
 #include "src/base/finite_options.h"
+#include "src/world/integrator_table.h"
 
 namespace jello {
+
+namespace {
+
+// "cg (what it is; the default), cholmod (...) or ldlt (...)" from a table, and its names.
+template <class Kind, class Name, class Summary>
+std::string describeAll(std::span<const Kind> kinds, Kind byDefault, Name name, Summary summary) {
+  return closed_set::sentence(kinds, [&](Kind kind) {
+    return std::string(name(kind)) + " (" + std::string(summary(kind)) +
+           (kind == byDefault ? "; the default)" : ")");
+  });
+}
+template <class Kind, class Name>
+std::vector<std::string> namesOf(std::span<const Kind> kinds, Name name) {
+  std::vector<std::string> names;
+  for (Kind kind : kinds) names.emplace_back(name(kind));
+  return names;
+}
+
+}  // namespace
 
 void addSolverFlags(CLI::App& app, SolverFlags& f) {
   auto& implicit = f.solver.implicit;
   auto& cvode = f.solver.cvode;
-  const char* implicitGroup =
-      "Implicit solvers (implicit, midpoint, newmark, bdf2, implicit-linear, cvode)";
+  using F = IntegratorFamily;
+  const std::string implicitGroup =
+      "Implicit solvers (" + integratorNames({F::Newton, F::Linearized, F::Cvode}) + ")";
+  // The integrators a flag applies to, as its help's prefix: "implicit, midpoint, ...: ".
+  const std::string newton = integratorNames({F::Newton}) + ": ";
+  const std::string projectiveOnly = integratorNames({F::Projective}) + ": ";
+  const std::string cvodeOnly = integratorNames({F::Cvode}) + ": ";
   // Every flag here is in the group; `option` also shows its default in --help, `bare` does
   // not (a 0 there means "derived" or "none", said in the text).
   const auto bare = [&](const char* name, auto& value, const std::string& help) {
@@ -22,16 +51,12 @@ void addSolverFlags(CLI::App& app, SolverFlags& f) {
     return app.add_flag(name, value, help)->group(implicitGroup);
   };
   bare("--linear-solver", f.linearSolver,
-       "cg (preconditioned, warm-started, matrix-free; the default), cholmod "
-       "(supernodal LLT) or ldlt")
-      ->check(CLI::IsMember({"cholmod", "ldlt", "cg"}));
+       describeAll(allLinearSolvers(), kDefaultLinearSolver, linearSolverName, linearSolverSummary))
+      ->check(CLI::IsMember(namesOf(allLinearSolvers(), linearSolverName)));
   option("--preconditioner", f.preconditioner,
-         "cg: jacobi, block-jacobi (each point's 3x3 block), ichol (incomplete "
-         "Cholesky), factor (a CHOLMOD factor of an earlier matrix, refreshed when CG "
-         "needs more than 10 iterations) or projective (the springs' Laplacian "
-         "M + L(a c + b k) with the contacts on its diagonal, factored once per step "
-         "size and contact set)")
-      ->check(CLI::IsMember({"jacobi", "block-jacobi", "ichol", "factor", "projective"}));
+         "cg: " + describeAll(allPreconditioners(), kDefaultPreconditioner, preconditionerName,
+                              preconditionerSummary))
+      ->check(CLI::IsMember(namesOf(allPreconditioners(), preconditionerName)));
   flag("--csr-product", f.csrProduct,
        "cg: multiply by the sparse matrix instead of through the spring kernels");
   flag("--no-clamp", f.noClamp,
@@ -39,70 +64,81 @@ void addSolverFlags(CLI::App& app, SolverFlags& f) {
   option("--cg-tol", implicit.cgTolerance, "Relative residual of CG solves")
       ->check(cli::positive());
   option("--newton-iters", implicit.newtonMaxIterations,
-         "implicit, midpoint, newmark, bdf2: most Newton iterations per step (a step "
-         "still unconverged is counted and reported)")
+         newton +
+             "most Newton iterations per step (a step "
+             "still unconverged is counted and reported)")
       ->check(cli::range(1, 1000));
   option("--newton-tol", implicit.newtonTolerance,
-         "implicit, midpoint, newmark, bdf2: relative residual that ends the iterations")
+         newton + "relative residual that ends the iterations")
       ->check(cli::positive());
   option("--newton-xtol", implicit.newtonPositionTolerance,
-         "implicit, midpoint, newmark, bdf2: a Newton update moving no coordinate more "
-         "than this (m) also ends them")
+         newton +
+             "a Newton update moving no coordinate more "
+             "than this (m) also ends them")
       ->check(cli::positive());
   flag("--no-factor-reuse", f.noFactorReuse,
-       "implicit, midpoint, newmark, bdf2: factor the Newton matrix at every iteration "
-       "(plain Newton) instead of keeping it while it converges fast enough");
+       newton +
+           "factor the Newton matrix at every iteration "
+           "(plain Newton) instead of keeping it while it converges fast enough");
   option("--refactor-ratio", implicit.refactorRatio,
-         "implicit, midpoint, newmark, bdf2: factor afresh when an iteration shrinks "
-         "the residual by less than this")
+         newton +
+             "factor afresh when an iteration shrinks "
+             "the residual by less than this")
       ->check(cli::range(1e-6, 1.0));
   option("--newton-seed", implicit.seedIterations,
-         "implicit, midpoint, newmark, bdf2: iterations with the constant projective "
-         "matrix before Newton (stopped at the first iterate in contact; 0: none)")
+         newton +
+             "iterations with the constant projective "
+             "matrix before Newton (stopped at the first iterate in contact; 0: none)")
       ->check(cli::range(0, 1000));
   option("--newton-seed-tol", implicit.seedTolerance,
-         "implicit, midpoint, newmark, bdf2: relative residual that ends the seed "
-         "iterations (at or below --newton-tol they may converge the step themselves)")
+         newton +
+             "relative residual that ends the seed "
+             "iterations (at or below --newton-tol they may converge the step themselves)")
       ->check(cli::positive());
   option("--newton-seed-chebyshev", implicit.seedChebyshevRho,
-         "implicit, midpoint, newmark, bdf2: Chebyshev acceleration of the seed "
-         "iterations with this rho, as --projective-chebyshev (0: off; 0.9 measured "
-         "best with --newton-seed-tol 1e-8)")
+         newton +
+             "Chebyshev acceleration of the seed "
+             "iterations with this rho, as --projective-chebyshev (0: off; 0.9 measured "
+             "best with --newton-seed-tol 1e-8)")
       ->check(cli::range(0.0, 0.999));
   auto& projective = f.solver.projective;
   option("--projective-iters", projective.iterations,
-         "projective: local/global iterations per step")
+         projectiveOnly + "local/global iterations per step")
       ->check(cli::range(1, 100000));
   option("--projective-tol", projective.tolerance,
-         "projective: stop a step's iterations early once an update moves no coordinate "
-         "more than this (m; 0: never early)")
+         projectiveOnly +
+             "stop a step's iterations early once an update moves no coordinate "
+             "more than this (m; 0: never early)")
       ->check(cli::nonNegative());
   option("--projective-chebyshev", projective.chebyshevRho,
-         "projective: Chebyshev acceleration of the iterations (Wang 2015) with this "
-         "assumed contraction rho, after 2 plain iterations (0: off; 0.85 measured best "
-         "on the spinning stiff cube)")
+         projectiveOnly +
+             "Chebyshev acceleration of the iterations (Wang 2015) with this "
+             "assumed contraction rho, after 2 plain iterations (0: off; 0.85 measured best "
+             "on the spinning stiff cube)")
       ->check(cli::range(0.0, 0.999));
-  option("--rtol", cvode.rtol, "cvode: relative tolerance")->check(cli::positive());
+  option("--rtol", cvode.rtol, cvodeOnly + "relative tolerance")->check(cli::positive());
   option("--cvode-method", f.cvodeMethod,
-         "cvode: bdf (stiff: Newton over the implicit system) or adams (non-stiff: "
-         "fixed-point iterations, no linear algebra)")
+         cvodeOnly +
+             "bdf (stiff: Newton over the implicit system) or adams (non-stiff: "
+             "fixed-point iterations, no linear algebra)")
       ->check(CLI::IsMember({"bdf", "adams"}));
   bare("--atol", f.atol,
-       "cvode: absolute tolerance of positions (m) and velocities (m/s) (default "
-       "1e-3 * rtol)")
+       cvodeOnly +
+           "absolute tolerance of positions (m) and velocities (m/s) (default "
+           "1e-3 * rtol)")
       ->check(cli::positive());
-  bare("--atol-x", cvode.atolPosition, "cvode: absolute tolerance of positions (m)")
+  bare("--atol-x", cvode.atolPosition, cvodeOnly + "absolute tolerance of positions (m)")
       ->check(cli::positive());
-  bare("--atol-v", cvode.atolVelocity, "cvode: absolute tolerance of velocities (m/s)")
+  bare("--atol-v", cvode.atolVelocity, cvodeOnly + "absolute tolerance of velocities (m/s)")
       ->check(cli::positive());
   flag("--cvode-krylov", cvode.krylov,
        "cvode (bdf): solve Newton's systems by SPGMR, matrix-free, preconditioned by "
        "the reduced system (--linear-solver), its factor kept between setups");
   flag("--contact-roots", cvode.contactRoots,
-       "cvode: locate contact onset and release as roots and restart there");
-  option("--max-order", cvode.maxOrder, "cvode: largest BDF order")->check(cli::range(1, 5));
-  flag("--no-stab-lim-det", f.noStabLimDet, "cvode: switch off BDF stability-limit detection");
-  bare("--max-step", cvode.maxStep, "cvode: largest internal step, s (default none)")
+       cvodeOnly + "locate contact onset and release as roots and restart there");
+  option("--max-order", cvode.maxOrder, cvodeOnly + "largest BDF order")->check(cli::range(1, 5));
+  flag("--no-stab-lim-det", f.noStabLimDet, cvodeOnly + "switch off BDF stability-limit detection");
+  bare("--max-step", cvode.maxStep, cvodeOnly + "largest internal step, s (default none)")
       ->check(cli::positive());
 }
 

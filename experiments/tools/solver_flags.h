@@ -12,7 +12,7 @@ namespace jello {
 struct SolverFlags {
   SolverOptions solver;      // the options the flags set directly
   std::string linearSolver;  // empty: SolverOptions' defaults
-  std::string preconditioner = "jacobi";
+  std::string preconditioner{preconditionerName(kDefaultPreconditioner)};
   bool csrProduct = false;
   bool noClamp = false, noStabLimDet = false, noFactorReuse = false;
   std::string cvodeMethod = "bdf";

@@ -328,31 +328,19 @@ int CvodeIntegrator::solve(const double* b, double* x) {
 }
 
 int CvodeIntegrator::numRootFunctions() const {
-  const int n = n3_ / 3;
-  return (model_->hasWalls() ? 3 * n : 0) + (model_->hasPlane() ? n : 0) +
-         (model_->hasSphere() ? n : 0);
+  int count = 0;
+  for (const auto& obstacle : model_->obstacles()) count += obstacle->rootsPerPoint();
+  return count * (n3_ / 3);
 }
 
-// Penetration depths as functions that change sign where a contact begins or ends: positive
-// on the free side.
+// Every obstacle's root functions (src/effects/obstacle.h): they change sign where a contact
+// begins or ends, positive on the free side.
 int CvodeIntegrator::contactDepths(const double* y, double* g) {
   const int n = n3_ / 3;
   x_ = Eigen::Map<const Eigen::VectorXd>(y, n3_) + shift_;
-  const double* x = x_.data();
-  if (model_->hasWalls()) {
-    for (int i = 0; i < n3_; ++i) *g++ = kBoxHalfSize - std::abs(x[i]);
-  }
-  if (const auto& plane = model_->plane()) {
-    const Vec3 u = plane->normal();
-    for (int p = 0; p < n; ++p) {
-      *g++ = u.x * x[p] + u.y * x[n + p] + u.z * x[2 * n + p] + plane->offset();
-    }
-  }
-  if (const auto& sphere = model_->sphere()) {
-    const Sphere& sp = sphere->sphere();
-    for (int p = 0; p < n; ++p) {
-      *g++ = norm(Vec3{x[p], x[n + p], x[2 * n + p]} - sp.center) - sp.radius;
-    }
+  for (const auto& obstacle : model_->obstacles()) {
+    obstacle->roots(x_.data(), n, g);
+    g += obstacle->rootsPerPoint() * n;
   }
   return 0;
 }

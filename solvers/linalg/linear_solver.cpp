@@ -9,6 +9,7 @@
 
 #include "solvers/linalg/blas_headroom.h"
 #include "solvers/linalg/prefactored_cholesky.h"
+#include "src/base/closed_set.h"
 
 namespace jello {
 namespace {
@@ -101,48 +102,46 @@ bool invertBlocks(const std::array<const double*, 6>& g, Eigen::Index n,
 
 }  // namespace
 
-std::optional<PreconditionerKind> parsePreconditioner(std::string_view name) {
-  if (name == "jacobi") return PreconditionerKind::Jacobi;
-  if (name == "block-jacobi") return PreconditionerKind::BlockJacobi;
-  if (name == "ichol") return PreconditionerKind::IncompleteCholesky;
-  if (name == "factor") return PreconditionerKind::Factor;
-  if (name == "projective") return PreconditionerKind::Projective;
-  return std::nullopt;
-}
+namespace {
 
-std::string_view preconditionerName(PreconditionerKind kind) {
-  switch (kind) {
-    case PreconditionerKind::Jacobi:
-      return "jacobi";
-    case PreconditionerKind::BlockJacobi:
-      return "block-jacobi";
-    case PreconditionerKind::IncompleteCholesky:
-      return "ichol";
-    case PreconditionerKind::Factor:
-      return "factor";
-    case PreconditionerKind::Projective:
-      return "projective";
-  }
-  return "?";
-}
+constexpr closed_set::Row<LinearSolverKind> kLinearSolvers[] = {
+#define JELLO_LINEAR_SOLVER_ROW(kind, name, summary) {LinearSolverKind::kind, name, summary},
+    JELLO_LINEAR_SOLVERS(JELLO_LINEAR_SOLVER_ROW)
+#undef JELLO_LINEAR_SOLVER_ROW
+};
+constexpr auto kLinearSolverKinds = closed_set::kinds(kLinearSolvers);
+constexpr closed_set::Row<PreconditionerKind> kPreconditioners[] = {
+#define JELLO_PRECONDITIONER_ROW(kind, name, summary) {PreconditionerKind::kind, name, summary},
+    JELLO_PRECONDITIONERS(JELLO_PRECONDITIONER_ROW)
+#undef JELLO_PRECONDITIONER_ROW
+};
+constexpr auto kPreconditionerKinds = closed_set::kinds(kPreconditioners);
+
+}  // namespace
 
 std::optional<LinearSolverKind> parseLinearSolver(std::string_view name) {
-  if (name == "cholmod") return LinearSolverKind::Cholmod;
-  if (name == "ldlt") return LinearSolverKind::Ldlt;
-  if (name == "cg") return LinearSolverKind::Cg;
-  return std::nullopt;
+  return closed_set::parse(kLinearSolvers, name);
 }
-
 std::string_view linearSolverName(LinearSolverKind kind) {
-  switch (kind) {
-    case LinearSolverKind::Cholmod:
-      return "cholmod";
-    case LinearSolverKind::Ldlt:
-      return "ldlt";
-    case LinearSolverKind::Cg:
-      return "cg";
-  }
-  return "?";
+  return closed_set::row(kLinearSolvers, kind).name;
+}
+std::string_view linearSolverSummary(LinearSolverKind kind) {
+  return closed_set::row(kLinearSolvers, kind).summary;
+}
+std::span<const LinearSolverKind> allLinearSolvers() {
+  return kLinearSolverKinds;
+}
+std::optional<PreconditionerKind> parsePreconditioner(std::string_view name) {
+  return closed_set::parse(kPreconditioners, name);
+}
+std::string_view preconditionerName(PreconditionerKind kind) {
+  return closed_set::row(kPreconditioners, kind).name;
+}
+std::string_view preconditionerSummary(PreconditionerKind kind) {
+  return closed_set::row(kPreconditioners, kind).summary;
+}
+std::span<const PreconditionerKind> allPreconditioners() {
+  return kPreconditionerKinds;
 }
 
 SpdSolver::SpdSolver(LinearSolverKind kind, double cgTolerance)

@@ -1,29 +1,23 @@
 // Solves A x = b for the symmetric systems of the implicit integrators, A = M - a D - b K
-// (3n x 3n, fixed pattern). Three methods:
-//   cholmod  CHOLMOD supernodal LLT (through Eigen's CholmodSupport): symbolic analysis once,
-//            numeric factorization per matrix. If A is not positive definite (possible only
-//            with the compression clamp off), it falls back to CHOLMOD's simplicial LDLT, and
-//            the solution is accepted only if its residual |Ax - b| <= 1e-8 |b|. Fallbacks are
-//            counted.
-//   ldlt     CHOLMOD simplicial LDLT, residual-checked the same way.
-//   cg       preconditioned conjugate gradients, warm-started from x, on the sparse matrix or,
-//            given a LinearOperator (solvers/system/system_operator.h: matrix-free through the
-//            spring kernels). Preconditioners:
-//              jacobi        the diagonal of A
-//              block-jacobi  each point's 3x3 diagonal block of A, inverted
-//              ichol         incomplete Cholesky of A (Eigen, AMD ordering, shifted if needed)
-//              factor        a CHOLMOD factorization of an earlier A, kept while CG converges
-//                            in few iterations (at most kStaleFactorIterations) and refreshed at
-//                            the next set-up after a solve that needed more
-//              projective    the springs' Laplacian M + L(a c + b k) on each coordinate
-//                            (solvers/system/spring_laplacian.h), factored once per a and b: it
-//                            bounds A's spring part from above, so it is kept however the cube
-//                            turns
+// (3n x 3n, fixed pattern), by one of the linear solvers of the table below:
+//   cholmod  symbolic analysis once, numeric factorization per matrix. If A is not positive
+//            definite (possible only with the compression clamp off), it falls back to
+//            CHOLMOD's simplicial LDLT, and the solution is accepted only if its residual
+//            |Ax - b| <= 1e-8 |b|. Fallbacks are counted.
+//   ldlt     residual-checked the same way.
+//   cg       warm-started from x, on the sparse matrix or, given a LinearOperator, through its
+//            product (solvers/system/system_operator.h: matrix-free through the spring
+//            kernels), with one of the preconditioners of the second table. `factor` is kept
+//            while CG converges in at most kStaleFactorIterations and refreshed at the next
+//            set-up after a solve that needed more; `projective` solves with a factored matrix
+//            the caller gives (the implicit system's spring Laplacian, which bounds A's spring
+//            part from above, so it is kept however the cube turns).
 #pragma once
 
 #include <Eigen/Core>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -33,23 +27,58 @@
 
 namespace jello {
 
-enum class LinearSolverKind { Cholmod, Ldlt, Cg };
-enum class PreconditionerKind { Jacobi, BlockJacobi, IncompleteCholesky, Factor, Projective };
+// The one table of linear solvers and the one of CG's preconditioners: enumerator, name, what
+// it is (help texts, the panel, the Python module and the studies read them from here).
+#define JELLO_LINEAR_SOLVERS(X)                                                \
+  X(Cholmod, "cholmod", "supernodal LLT (CHOLMOD), factored per matrix")       \
+  X(Ldlt, "ldlt", "simplicial LDLT (CHOLMOD), its solutions residual-checked") \
+  X(Cg, "cg", "conjugate gradients: preconditioned, warm-started, matrix-free")
+#define JELLO_PRECONDITIONERS(X)                                                           \
+  X(Jacobi, "jacobi", "the diagonal")                                                      \
+  X(BlockJacobi, "block-jacobi", "each point's 3x3 block")                                 \
+  X(IncompleteCholesky, "ichol", "incomplete Cholesky")                                    \
+  X(Factor, "factor",                                                                      \
+    "a CHOLMOD factor of an earlier matrix, refreshed when CG needs more than 10 "         \
+    "iterations")                                                                          \
+  X(Projective, "projective",                                                              \
+    "the springs' Laplacian M + L(a c + b k) with the contacts on its diagonal, factored " \
+    "once per step size and contact set")
 
+enum class LinearSolverKind {
+#define JELLO_LINEAR_SOLVER_ENUMERATOR(kind, name, summary) kind,
+  JELLO_LINEAR_SOLVERS(JELLO_LINEAR_SOLVER_ENUMERATOR)
+#undef JELLO_LINEAR_SOLVER_ENUMERATOR
+};
+enum class PreconditionerKind {
+#define JELLO_PRECONDITIONER_ENUMERATOR(kind, name, summary) kind,
+  JELLO_PRECONDITIONERS(JELLO_PRECONDITIONER_ENUMERATOR)
+#undef JELLO_PRECONDITIONER_ENUMERATOR
+};
+
+// The default of every implicit integrator and of CVODE: CG (Jacobi, matrix-free) takes the
+// same converged steps in well under CHOLMOD's time on jello.w and the spinning cube; CHOLMOD
+// stays faster where one kept factorization serves every step (a stiff cube at rest).
+inline constexpr LinearSolverKind kDefaultLinearSolver = LinearSolverKind::Cg;
+inline constexpr PreconditionerKind kDefaultPreconditioner = PreconditionerKind::Jacobi;
+
+// Names in any case; every name in the table's order; each one's summary.
 std::optional<LinearSolverKind> parseLinearSolver(std::string_view name);
 std::string_view linearSolverName(LinearSolverKind kind);
-// "jacobi", "block-jacobi", "ichol", "factor", "projective".
+std::string_view linearSolverSummary(LinearSolverKind kind);
+std::span<const LinearSolverKind> allLinearSolvers();
 std::optional<PreconditionerKind> parsePreconditioner(std::string_view name);
 std::string_view preconditionerName(PreconditionerKind kind);
+std::string_view preconditionerSummary(PreconditionerKind kind);
+std::span<const PreconditionerKind> allPreconditioners();
 
 // A stale factor is refreshed after a solve that took more CG iterations than this.
 inline constexpr int kStaleFactorIterations = 10;
 
 struct LinearSolverOptions {
-  LinearSolverKind kind = LinearSolverKind::Cholmod;
+  LinearSolverKind kind = kDefaultLinearSolver;
   double cgTolerance = 1e-6;  // relative residual |A x - b| <= tol |b|
-  PreconditionerKind preconditioner = PreconditionerKind::Jacobi;
-  bool matrixFree = true;  // cg: the product through the spring kernels where it is given
+  PreconditionerKind preconditioner = kDefaultPreconditioner;
+  bool matrixFree = true;  // cg: the product through the operator where one is given
 };
 
 class PrefactoredCholesky;

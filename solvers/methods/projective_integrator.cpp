@@ -61,38 +61,21 @@ void ProjectiveIntegrator::bind(const Model& model) {
 
 bool ProjectiveIntegrator::contactWeights(const Model& model, const double* x, std::ptrdiff_t lo,
                                           std::ptrdiff_t hi) {
-  const std::ptrdiff_t n = n_;
-  const auto& walls = model.walls();
-  const double kc = walls ? walls->constants().stiffness : 0.0;
-  const bool solids = model.hasSolids();
-  // The largest difference from the factor's weights (both 0 or a contact's stiffness): a max,
-  // not a flag, so that the loops vectorize.
+  // Each obstacle's stiffness per contact spring, on the coordinates it reaches.
+  const std::array<double*, 3> w{weights_[0].data(), weights_[1].data(), weights_[2].data()};
+  for (int c = 0; c < 3; ++c) std::fill(w[c] + lo, w[c] + hi, 0.0);
+  for (const auto& obstacle : model.obstacles()) {
+    obstacle->addContactWeights(x, n_, lo, hi, obstacle->constants().stiffness, w);
+  }
+  // The largest difference from the factor's weights: a max, not a flag, so that the loops
+  // vectorize.
   double differs = 0.0;
   for (int c = 0; c < 3; ++c) {
-    double* w = weights_[c].data();
-    const double* xc = x + c * n;
-    const double* factored = factoredWeights_[factorOf_[c]].data();
-    // The walls' weight where the coordinate is outside the box.
-#pragma omp simd reduction(max : differs)
-    for (std::ptrdiff_t p = lo; p < hi; ++p) {
-      const double wp = std::abs(xc[p]) > kBoxHalfSize ? kc : 0.0;
-      w[p] = wp;
-      differs = std::max(differs, std::abs(wp - factored[p]));
-    }
-  }
-  if (!solids) return differs > 0.0;
-  const auto stiffness = [](const ContactConstants& k) { return k.stiffness; };
-  for (std::ptrdiff_t p = lo; p < hi; ++p) {
-    const double w = model.solidContactWeight({x[p], x[n + p], x[2 * n + p]}, stiffness);
-    for (int c = 0; c < 3; ++c) weights_[c][p] += w;
-  }
-  differs = 0.0;
-  for (int c = 0; c < 3; ++c) {
-    const double* w = weights_[c].data();
+    const double* wc = w[c];
     const double* factored = factoredWeights_[factorOf_[c]].data();
 #pragma omp simd reduction(max : differs)
     for (std::ptrdiff_t p = lo; p < hi; ++p)
-      differs = std::max(differs, std::abs(w[p] - factored[p]));
+      differs = std::max(differs, std::abs(wc[p] - factored[p]));
   }
   return differs > 0.0;
 }

@@ -10,22 +10,17 @@
 namespace jello {
 namespace {
 
-// C of factorProjective at positions x (3n): b kc + a dc per contact a point is in.
+// C of factorProjective at positions x (3n): b kc + a dc per contact spring a point has, over
+// every obstacle.
 void contactDiagonal(const Model& model, const double* x, double a, double b,
                      Eigen::VectorXd& out) {
   const int n = model.numPoints();
   out.setZero(n);
-  const auto weight = [a, b](const ContactConstants& k) { return b * k.stiffness + a * k.damping; };
-  if (const auto& walls = model.walls()) {
-    const double w = weight(walls->constants());
-    for (int c = 0; c < 3; ++c)
-      for (int p = 0; p < n; ++p) {
-        if (std::abs(x[c * n + p]) > kBoxHalfSize) out[p] += w;
-      }
+  for (const auto& obstacle : model.obstacles()) {
+    const ContactConstants& k = obstacle->constants();
+    const double w = b * k.stiffness + a * k.damping;
+    for (int p = 0; p < n; ++p) out[p] += w * obstacle->contactSprings(pointAt(x, n, p));
   }
-  if (!model.hasSolids()) return;
-  for (int p = 0; p < n; ++p)
-    out[p] += model.solidContactWeight({x[p], x[n + p], x[2 * n + p]}, weight);
 }
 
 }  // namespace

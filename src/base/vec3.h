@@ -29,6 +29,11 @@ constexpr double dot(const Vec3& a, const Vec3& b) {
 constexpr Vec3 cross(const Vec3& a, const Vec3& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
+// Point p of a 3n component-major array (x of every point, then y, then z).
+inline Vec3 pointAt(const double* x, int n, int p) {
+  return {x[p], x[n + p], x[2 * n + p]};
+}
+
 inline double norm(const Vec3& a) {
   return std::sqrt(dot(a, a));
 }

@@ -20,6 +20,17 @@ double* blockOf(double* diag, int p) {
 
 }  // namespace
 
+std::string_view obstacleName(ObstacleKind kind) {
+  switch (kind) {
+#define JELLO_OBSTACLE_NAME(kind, name) \
+  case ObstacleKind::kind:              \
+    return name;
+    JELLO_OBSTACLES(JELLO_OBSTACLE_NAME)
+#undef JELLO_OBSTACLE_NAME
+  }
+  return "?";
+}
+
 // The loops below are branch-free (selects, an OR reduction) so that they vectorize: they run
 // in every force evaluation.
 
@@ -30,17 +41,17 @@ bool WallContact::allInside(const double* __restrict x, int n, int lo, int hi) {
   return outside == 0;
 }
 
-void WallContact::accumulate(const double* __restrict x, const double* __restrict v,
-                             double* __restrict f, int n, int lo, int hi) const {
-  // Each component is its own pair of walls: normal -/+ e_c, so the spring acts on that
-  // component alone.
-  const double k = k_.stiffness, c = k_.damping;
+bool WallContact::addForces(const double* __restrict x, const double* __restrict v,
+                            double* __restrict f, int n, int lo, int hi) const {
+  if (allInside(x, n, lo, hi)) return false;
+  const double k = constants().stiffness, c = constants().damping;
   for (int e = 0; e < 3; ++e)
     for (int i = e * n + lo; i < e * n + hi; ++i) {
       const double over = x[i] - kBoxHalfSize, under = x[i] + kBoxHalfSize;
       const double depth = over > 0.0 ? over : under < 0.0 ? under : 0.0;
       f[i] -= depth != 0.0 ? k * depth + c * v[i] : 0.0;
     }
+  return true;
 }
 
 double WallContact::energy(const double* x, int n) const {
@@ -49,19 +60,50 @@ double WallContact::energy(const double* x, int n) const {
     const double depth = std::max(0.0, std::abs(x[i]) - kBoxHalfSize);
     e += depth * depth;
   }
-  return 0.5 * k_.stiffness * e;
+  return 0.5 * constants().stiffness * e;
 }
 
 void WallContact::addJacobian(const double* x, int n, JacobianBlocks& out) const {
   for (int axis = 0; axis < 3; ++axis)
     for (int p = 0; p < n; ++p) {
       if (std::abs(x[axis * n + p]) <= kBoxHalfSize) continue;
-      blockOf(out.diagK, p)[4 * axis] -= k_.stiffness;  // entry (axis, axis) of the block
-      blockOf(out.diagD, p)[4 * axis] -= k_.damping;
+      blockOf(out.diagK, p)[4 * axis] -= constants().stiffness;  // entry (axis, axis)
+      blockOf(out.diagD, p)[4 * axis] -= constants().damping;
     }
 }
 
-PlaneContact::PlaneContact(const Plane& plane, ContactConstants k) : k_(k) {
+double WallContact::depth(const Vec3& x) const {
+  return std::max({0.0, std::abs(x.x) - kBoxHalfSize, std::abs(x.y) - kBoxHalfSize,
+                   std::abs(x.z) - kBoxHalfSize});
+}
+
+bool WallContact::contactBegins(const double* x0, const double* x1, int n) const {
+  for (int i = 0; i < 3 * n; ++i) {
+    if (std::abs(x1[i]) > kBoxHalfSize && std::abs(x0[i]) <= kBoxHalfSize) return true;
+  }
+  return false;
+}
+
+int WallContact::contactSprings(const Vec3& x) const {
+  return int(std::abs(x.x) > kBoxHalfSize) + int(std::abs(x.y) > kBoxHalfSize) +
+         int(std::abs(x.z) > kBoxHalfSize);
+}
+
+void WallContact::addContactWeights(const double* x, int n, std::ptrdiff_t lo, std::ptrdiff_t hi,
+                                    double weight, const std::array<double*, 3>& w) const {
+  for (int c = 0; c < 3; ++c) {
+    const double* __restrict xc = x + c * static_cast<std::ptrdiff_t>(n);
+    double* __restrict wc = w[c];
+#pragma omp simd
+    for (std::ptrdiff_t p = lo; p < hi; ++p) wc[p] += std::abs(xc[p]) > kBoxHalfSize ? weight : 0.0;
+  }
+}
+
+void WallContact::roots(const double* x, int n, double* g) const {
+  for (int i = 0; i < 3 * n; ++i) g[i] = kBoxHalfSize - std::abs(x[i]);
+}
+
+PlaneContact::PlaneContact(const Plane& plane, ContactConstants k) : Obstacle(k) {
   // Scaled by the largest coefficient first: normals from 1e-300 to 1e300 give the same plane.
   const Vec3 n{plane.a, plane.b, plane.c};
   const double scale = maxAbs(n);
@@ -71,10 +113,10 @@ PlaneContact::PlaneContact(const Plane& plane, ContactConstants k) : k_(k) {
   offset_ = (plane.d / scale) / len;
 }
 
-void PlaneContact::accumulate(const double* __restrict x, const double* __restrict v,
-                              double* __restrict f, int n, int lo, int hi) const {
+bool PlaneContact::addForces(const double* __restrict x, const double* __restrict v,
+                             double* __restrict f, int n, int lo, int hi) const {
   const double ux = normal_.x, uy = normal_.y, uz = normal_.z;
-  const double k = k_.stiffness, c = k_.damping;
+  const double k = constants().stiffness, c = constants().damping;
   for (int p = lo; p < hi; ++p) {
     const double dist = ux * x[p] + uy * x[n + p] + uz * x[2 * n + p] + offset_;
     const double vn = ux * v[p] + uy * v[n + p] + uz * v[2 * n + p];
@@ -83,6 +125,7 @@ void PlaneContact::accumulate(const double* __restrict x, const double* __restri
     f[n + p] += s * uy;
     f[2 * n + p] += s * uz;
   }
+  return true;
 }
 
 double PlaneContact::energy(const double* x, int n) const {
@@ -92,20 +135,46 @@ double PlaneContact::energy(const double* x, int n) const {
         normal_.x * x[p] + normal_.y * x[n + p] + normal_.z * x[2 * n + p] + offset_;
     if (dist < 0.0) e += dist * dist;
   }
-  return 0.5 * k_.stiffness * e;
+  return 0.5 * constants().stiffness * e;
 }
 
 void PlaneContact::addJacobian(const double* x, int n, JacobianBlocks& out) const {
   for (int p = 0; p < n; ++p) {
     const Vec3 xp{x[p], x[n + p], x[2 * n + p]};
     if (dot(normal_, xp) + offset_ >= 0.0) continue;
-    addOuter(blockOf(out.diagK, p), normal_, -k_.stiffness);
-    addOuter(blockOf(out.diagD, p), normal_, -k_.damping);
+    addOuter(blockOf(out.diagK, p), normal_, -constants().stiffness);
+    addOuter(blockOf(out.diagD, p), normal_, -constants().damping);
   }
 }
 
-void SphereContact::accumulate(const double* x, const double* v, double* f, int n, int lo,
-                               int hi) const {
+double PlaneContact::depth(const Vec3& x) const {
+  return std::max(0.0, -side(x));
+}
+
+bool PlaneContact::contactBegins(const double* x0, const double* x1, int n) const {
+  for (int p = 0; p < n; ++p) {
+    if (side(pointAt(x1, n, p)) < 0.0 && side(pointAt(x0, n, p)) >= 0.0) return true;
+  }
+  return false;
+}
+
+int PlaneContact::contactSprings(const Vec3& x) const {
+  return side(x) < 0.0 ? 1 : 0;
+}
+
+void PlaneContact::addContactWeights(const double* x, int n, std::ptrdiff_t lo, std::ptrdiff_t hi,
+                                     double weight, const std::array<double*, 3>& w) const {
+  addToAllCoordinates(lo, hi, weight, w,
+                      [&](std::ptrdiff_t p) { return side(pointAt(x, n, int(p))) < 0.0; });
+}
+
+void PlaneContact::roots(const double* x, int n, double* g) const {
+  const Vec3 u = normal_;
+  for (int p = 0; p < n; ++p) g[p] = u.x * x[p] + u.y * x[n + p] + u.z * x[2 * n + p] + offset_;
+}
+
+bool SphereContact::addForces(const double* x, const double* v, double* f, int n, int lo,
+                              int hi) const {
   const Vec3 c = sphere_.center;
   const double r = sphere_.radius;
   for (int p = lo; p < hi; ++p) {
@@ -115,11 +184,12 @@ void SphereContact::accumulate(const double* x, const double* v, double* f, int 
     const double l = std::sqrt(l2);
     const Vec3 u = l > 0.0 ? d * (1.0 / l) : Vec3{0.0, 0.0, 1.0};  // centre: push up
     const double vn = u.x * v[p] + u.y * v[n + p] + u.z * v[2 * n + p];
-    const double s = k_.stiffness * (r - l) - k_.damping * vn;
+    const double s = constants().stiffness * (r - l) - constants().damping * vn;
     f[p] += s * u.x;
     f[n + p] += s * u.y;
     f[2 * n + p] += s * u.z;
   }
+  return true;
 }
 
 double SphereContact::energy(const double* x, int n) const {
@@ -130,7 +200,7 @@ double SphereContact::energy(const double* x, int n) const {
     const double depth = sphere_.radius - norm(d);
     if (depth > 0.0) e += depth * depth;
   }
-  return 0.5 * k_.stiffness * e;
+  return 0.5 * constants().stiffness * e;
 }
 
 void SphereContact::addJacobian(const double* x, int n, JacobianBlocks& out) const {
@@ -141,12 +211,37 @@ void SphereContact::addJacobian(const double* x, int n, JacobianBlocks& out) con
     if (!(l < R && l > 0.0)) continue;
     const Vec3 u = r * (1.0 / l);
     // The curvature term kc (R/l - 1)(I - n n^T): positive, dropped by the clamp.
-    const double t = out.clampCompression ? 0.0 : k_.stiffness * (R / l - 1.0);
+    const double t = out.clampCompression ? 0.0 : constants().stiffness * (R / l - 1.0);
     double* K = blockOf(out.diagK, p);
-    addOuter(K, u, -k_.stiffness - t);
+    addOuter(K, u, -constants().stiffness - t);
     for (int e = 0; e < 3; ++e) K[4 * e] += t;
-    addOuter(blockOf(out.diagD, p), u, -k_.damping);
+    addOuter(blockOf(out.diagD, p), u, -constants().damping);
   }
+}
+
+double SphereContact::depth(const Vec3& x) const {
+  return std::max(0.0, sphere_.radius - norm(x - sphere_.center));
+}
+
+bool SphereContact::contactBegins(const double* x0, const double* x1, int n) const {
+  for (int p = 0; p < n; ++p) {
+    if (inside(pointAt(x1, n, p)) && !inside(pointAt(x0, n, p))) return true;
+  }
+  return false;
+}
+
+int SphereContact::contactSprings(const Vec3& x) const {
+  return inside(x) ? 1 : 0;
+}
+
+void SphereContact::addContactWeights(const double* x, int n, std::ptrdiff_t lo, std::ptrdiff_t hi,
+                                      double weight, const std::array<double*, 3>& w) const {
+  addToAllCoordinates(lo, hi, weight, w,
+                      [&](std::ptrdiff_t p) { return inside(pointAt(x, n, int(p))); });
+}
+
+void SphereContact::roots(const double* x, int n, double* g) const {
+  for (int p = 0; p < n; ++p) g[p] = norm(pointAt(x, n, p) - sphere_.center) - sphere_.radius;
 }
 
 }  // namespace jello

@@ -9,10 +9,6 @@ namespace jello {
 
 namespace {
 
-Vec3 at(const double* x, int n, int p) {
-  return {x[p], x[n + p], x[2 * n + p]};
-}
-
 // Any unit vector perpendicular to unit d.
 Vec3 perpendicular(const Vec3& d) {
   const Vec3 a = std::abs(d.x) < 0.9 ? Vec3{1.0, 0.0, 0.0} : Vec3{0.0, 1.0, 0.0};
@@ -141,48 +137,75 @@ std::optional<Penetration> spiralPenetration(const Spiral& s, const Vec3& x) {
   return p;
 }
 
-ObstacleContact::ObstacleContact(const Cone& cone, ContactConstants k) : cone_(cone), k_(k) {}
+ObstacleContact::ObstacleContact(const Cone& cone, ContactConstants k) : Obstacle(k), cone_(cone) {}
 ObstacleContact::ObstacleContact(const Spiral& spiral, ContactConstants k)
-    : spiral_(spiral), k_(k) {}
+    : Obstacle(k), spiral_(spiral) {}
 
 std::optional<Penetration> ObstacleContact::penetration(const Vec3& x) const {
   return cone_ ? conePenetration(*cone_, x) : spiralPenetration(*spiral_, x);
 }
 
-void ObstacleContact::accumulate(const double* x, const double* v, double* f, int n, int lo,
-                                 int hi) const {
+bool ObstacleContact::addForces(const double* x, const double* v, double* f, int n, int lo,
+                                int hi) const {
+  const ContactConstants& k = constants();
   for (int p = lo; p < hi; ++p) {
-    const std::optional<Penetration> q = penetration(at(x, n, p));
+    const std::optional<Penetration> q = penetration(pointAt(x, n, p));
     if (!q) continue;
     const Vec3 nrm = unitVector(q->gradient * -1.0);
-    const double vn = dot(nrm, at(v, n, p));
-    const Vec3 force = q->gradient * (-k_.stiffness * q->depth) - nrm * (k_.damping * vn);
+    const double vn = dot(nrm, pointAt(v, n, p));
+    const Vec3 force = q->gradient * (-k.stiffness * q->depth) - nrm * (k.damping * vn);
     f[p] += force.x;
     f[n + p] += force.y;
     f[2 * n + p] += force.z;
   }
+  return true;
 }
 
 double ObstacleContact::energy(const double* x, int n) const {
   double e = 0.0;
   for (int p = 0; p < n; ++p) {
-    if (const std::optional<Penetration> q = penetration(at(x, n, p))) e += q->depth * q->depth;
+    if (const std::optional<Penetration> q = penetration(pointAt(x, n, p)))
+      e += q->depth * q->depth;
   }
-  return 0.5 * k_.stiffness * e;
+  return 0.5 * constants().stiffness * e;
 }
 
 void ObstacleContact::addJacobian(const double* x, int n, JacobianBlocks& out) const {
+  const ContactConstants& k = constants();
   for (int p = 0; p < n; ++p) {
-    const std::optional<Penetration> q = penetration(at(x, n, p));
+    const std::optional<Penetration> q = penetration(pointAt(x, n, p));
     if (!q) continue;
     double* K = out.diagK + 9 * p;
-    setOuter(K, q->gradient, q->gradient, -k_.stiffness);
+    setOuter(K, q->gradient, q->gradient, -k.stiffness);
     if (!out.clampCompression) {
-      for (int i = 0; i < 9; ++i) K[i] -= k_.stiffness * q->depth * q->hessian[i];
+      for (int i = 0; i < 9; ++i) K[i] -= k.stiffness * q->depth * q->hessian[i];
     }
     const Vec3 nrm = unitVector(q->gradient * -1.0);
-    setOuter(out.diagD + 9 * p, nrm, nrm, -k_.damping);
+    setOuter(out.diagD + 9 * p, nrm, nrm, -k.damping);
   }
+}
+
+double ObstacleContact::depth(const Vec3& x) const {
+  const std::optional<Penetration> q = penetration(x);
+  return q ? q->depth : 0.0;
+}
+
+bool ObstacleContact::contactBegins(const double* x0, const double* x1, int n) const {
+  for (int p = 0; p < n; ++p) {
+    if (inside(pointAt(x1, n, p)) && !inside(pointAt(x0, n, p))) return true;
+  }
+  return false;
+}
+
+int ObstacleContact::contactSprings(const Vec3& x) const {
+  return inside(x) ? 1 : 0;
+}
+
+void ObstacleContact::addContactWeights(const double* x, int n, std::ptrdiff_t lo,
+                                        std::ptrdiff_t hi, double weight,
+                                        const std::array<double*, 3>& w) const {
+  addToAllCoordinates(lo, hi, weight, w,
+                      [&](std::ptrdiff_t p) { return inside(pointAt(x, n, int(p))); });
 }
 
 }  // namespace jello

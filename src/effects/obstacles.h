@@ -29,26 +29,27 @@ struct Penetration {
 std::optional<Penetration> conePenetration(const Cone& cone, const Vec3& x);
 std::optional<Penetration> spiralPenetration(const Spiral& spiral, const Vec3& x);
 
-// Penalty contact with one of them; all arrays component-major, n points.
-class ObstacleContact {
+// Penalty contact with one of them (src/effects/obstacle.h has what each method answers); all
+// arrays component-major, n points.
+class ObstacleContact final : public Obstacle {
  public:
   ObstacleContact(const Cone& cone, ContactConstants k);
   ObstacleContact(const Spiral& spiral, ContactConstants k);
-  const ContactConstants& constants() const { return k_; }
+  ObstacleKind kind() const override { return cone_ ? ObstacleKind::Cone : ObstacleKind::Spiral; }
   std::optional<Penetration> penetration(const Vec3& x) const;
   bool inside(const Vec3& x) const { return penetration(x).has_value(); }
-  void accumulate(const double* x, const double* v, double* f, int n) const {
-    accumulate(x, v, f, n, 0, n);
-  }
-  // The points [lo, hi) only.
-  void accumulate(const double* x, const double* v, double* f, int n, int lo, int hi) const;
-  double energy(const double* x, int n) const;
-  void addJacobian(const double* x, int n, JacobianBlocks& out) const;
+  bool addForces(const double* x, const double* v, double* f, int n, int lo, int hi) const override;
+  double energy(const double* x, int n) const override;
+  void addJacobian(const double* x, int n, JacobianBlocks& out) const override;
+  double depth(const Vec3& x) const override;
+  bool contactBegins(const double* x0, const double* x1, int n) const override;
+  int contactSprings(const Vec3& x) const override;
+  void addContactWeights(const double* x, int n, std::ptrdiff_t lo, std::ptrdiff_t hi,
+                         double weight, const std::array<double*, 3>& w) const override;
 
  private:
   std::optional<Cone> cone_;
   std::optional<Spiral> spiral_;
-  ContactConstants k_;
 };
 
 }  // namespace jello

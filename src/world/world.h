@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "src/base/vec3.h"
-#include "src/world/integrator_name.h"
+#include "src/world/integrator_table.h"
 
 namespace jello {
 

@@ -1,7 +1,10 @@
 #include <cmath>
 #include <optional>
+#include <span>
+#include <string>
 
 #include "experiments/python/module/bindings.h"
+#include "src/base/closed_set.h"
 #include "src/world/world_reader.h"
 
 namespace jello::python {
@@ -148,6 +151,17 @@ double chebyshevRho(double rho, const char* name) {
   return rho;
 }
 
+// "'a', 'b' or 'c'" from a table's names.
+template <class Kind, class Name>
+std::string quotedNames(std::span<const Kind> kinds, Name name) {
+  return jello::closed_set::sentence(kinds, [&](Kind kind) {
+    // Appended, not concatenated: GCC 12 warns falsely (-Wrestrict) on "'" + string.
+    std::string quoted(1, '\'');
+    quoted.append(name(kind)).push_back('\'');
+    return quoted;
+  });
+}
+
 bool boolOption(const py::handle& v, const std::string& name) {
   if (!py::isinstance<py::bool_>(v)) valueError(name + " must be True or False");
   return v.cast<bool>();
@@ -161,13 +175,15 @@ jello::SolverOptions solverOptionsFrom(const py::kwargs& kwargs, jello::SolverOp
     const auto real = [&] { return as<double>(value, name); };
     if (name == "linear_solver") {
       const auto kind = jello::parseLinearSolver(as<std::string>(value, name));
-      if (!kind) valueError("linear_solver must be 'cholmod', 'ldlt' or 'cg'");
+      if (!kind)
+        valueError("linear_solver must be one of " +
+                   quotedNames(jello::allLinearSolvers(), jello::linearSolverName));
       o.implicit.linearSolver = o.cvode.linearSolver = *kind;
     } else if (name == "preconditioner") {
       const auto kind = jello::parsePreconditioner(as<std::string>(value, name));
       if (!kind) {
-        valueError(
-            "preconditioner must be 'jacobi', 'block-jacobi', 'ichol', 'factor' or 'projective'");
+        valueError("preconditioner must be one of " +
+                   quotedNames(jello::allPreconditioners(), jello::preconditionerName));
       }
       o.implicit.preconditioner = o.cvode.preconditioner = *kind;
     } else if (name == "matrix_free") {

@@ -39,6 +39,25 @@ PYBIND11_MODULE(_core, m) {
         return d;
       },
       "Every integrator's name and a line about it, in the table's order.");
+  m.def(
+      "integrator_table",
+      [] {
+        py::list rows;
+        for (IntegratorKind k : jello::allIntegrators()) {
+          py::dict row;
+          row["name"] = std::string(jello::integratorName(k));
+          row["file_name"] = std::string(jello::integratorFileName(k));
+          row["family"] = std::string(jello::familyName(jello::integratorFamily(k)));
+          row["linear_model"] = std::string(jello::linearModelName(jello::linearModel(k)));
+          row["summary"] = std::string(jello::integratorSummary(k));
+          row["explicit"] = jello::isExplicit(k);
+          row["adaptive"] = jello::linearModel(k) == jello::LinearModel::Adaptive;
+          rows.append(row);
+        }
+        return rows;
+      },
+      "Every row of the integrator table with its traits (family, linear model, explicit, "
+      "adaptive), in the table's order.");
   m.def("loaded_blas", &jello::loadedBlas, "The BLAS library this process loaded.");
 
   // ---- the stability experiment's primitives (jello-stability)

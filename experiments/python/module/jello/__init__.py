@@ -57,6 +57,7 @@ from ._core import (  # noqa: E402  (the exceptions above must exist when it loa
     World,
     create_world,
     forces,
+    integrator_table,
     integrators,
     load_world,
     loaded_blas,
@@ -68,7 +69,7 @@ from ._core import (  # noqa: E402  (the exceptions above must exist when it loa
 )
 
 __all__ = [
-    "Diverged", "Simulation", "World", "WorldError", "create_world", "forces", "integrators",
-    "load_world", "loaded_blas", "parse_world", "predicted_threshold", "stability_scene",
+    "Diverged", "Simulation", "World", "WorldError", "create_world", "forces",
+    "integrator_table", "integrators", "load_world", "loaded_blas", "parse_world", "predicted_threshold", "stability_scene",
     "stability_threshold", "w_max",
 ]
