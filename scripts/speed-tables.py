@@ -19,6 +19,7 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import closed_sets  # noqa: E402
 from readme_blocks import write_blocks  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -28,7 +29,8 @@ THREADS_JSON = os.path.join(ROOT, "experiments", "results", "speed_threads.json"
 BINARY = os.path.join(ROOT, "build", "release", "bin", "benchmarks")
 FILTER = ("BM_SpringForces|BM_Step/|BM_Refill|BM_Factorize|BM_Solve/|BM_CgSolve|BM_SystemProduct|"
           "BM_ImplicitStep/|BM_StiffOneSecond")
-PRECONDITIONERS = ["jacobi", "block-jacobi", "ichol", "factor", "projective"]
+# BM_CgSolve's preconditioner argument is its row in the table (solvers/linalg/linear_solver.h).
+PRECONDITIONERS = [r["name"] for r in closed_sets.preconditioners()]
 
 
 def run(threads=True):

@@ -2,7 +2,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
+#include <memory>
 
+#include "solvers/integrator_factory.h"
 #include "solvers/methods/explicit_integrators.h"
 #include "tests/test_support.h"
 
@@ -111,6 +114,65 @@ TEST(RungeKutta4, ConvergesWithOrderFour) {
   const double e3 = positionError(rk4, 1e-4, ref);
   EXPECT_NEAR(std::log2(e1 / e2), 4.0, 0.3);
   EXPECT_NEAR(std::log2(e2 / e3), 4.0, 0.3);
+}
+
+// The integrator table's traits (src/world/integrator_table.h) are what each row's integrator
+// does: on the exactly linear oscillator its linear model predicts its energy, its family says
+// whether it has a stability limit, and every trait has a name. A row added with a wrong trait
+// fails here; one without a trait does not compile.
+double energyRatio(IntegratorKind kind, double y, int steps, bool worst = false) {
+  const Oscillator osc;
+  const std::unique_ptr<Integrator> method = makeIntegrator(kind);
+  State s = osc.start();
+  const double e0 = osc.energy(s), h = y / osc.omega();
+  double largest = 0.0;
+  for (int i = 0; i < steps; ++i) {
+    if (!method->step(osc.model, s, h).ok) return std::numeric_limits<double>::infinity();
+    largest = std::max(largest, osc.energy(s) / e0);
+  }
+  return worst ? largest : osc.energy(s) / e0;
+}
+
+TEST(IntegratorTable, EveryRowsLinearModelPredictsItsIntegratorOnALinearOscillator) {
+  for (IntegratorKind kind : allIntegrators()) {
+    SCOPED_TRACE(std::string(integratorName(kind)));
+    const LinearModel model = linearModel(kind);
+    EXPECT_NE(linearModelName(model), "?");
+    EXPECT_NE(familyName(integratorFamily(kind)), "?");
+    EXPECT_EQ(isExplicit(kind), hasStabilityLimit(model));
+    EXPECT_EQ(integratorFamily(kind) == IntegratorFamily::Cvode, model == LinearModel::Adaptive);
+    EXPECT_EQ(isExplicit(kind) || model == LinearModel::Adaptive, !isAStable(model));
+    switch (model) {
+      case LinearModel::ForwardEuler:
+        EXPECT_NEAR(energyRatio(kind, 0.5, 1), eulerFactor(0.5), 1e-12);
+        break;
+      case LinearModel::SymplecticEuler:
+        EXPECT_LT(energyRatio(kind, 1.9, 2000, true), 25.0);
+        EXPECT_GT(energyRatio(kind, 2.1, 40, true), 1e9);
+        break;
+      case LinearModel::RungeKutta4:
+        EXPECT_NEAR(energyRatio(kind, 2.0, 1), rk4Factor(2.0), 1e-12);
+        break;
+      case LinearModel::BackwardEuler:  // energy x 1/(1 + y^2) a step, at any y
+        EXPECT_NEAR(energyRatio(kind, 3.0, 1), 0.1, 1e-6);
+        EXPECT_LT(energyRatio(kind, 100.0, 50, true), 1.0);
+        break;
+      case LinearModel::Bdf2:  // damps the fast modes, the slow ones by far less
+        EXPECT_LT(energyRatio(kind, 100.0, 50), 1e-3);
+        // Backward Euler would keep 1/1.09^20 = 0.18 (most of BDF2's loss is its first step,
+        // backward Euler's).
+        EXPECT_GT(energyRatio(kind, 0.3, 20), 0.8);
+        break;
+      case LinearModel::Trapezoidal:  // keeps the energy of a linear mode at any step
+        EXPECT_NEAR(energyRatio(kind, 3.0, 20), 1.0, 1e-6);
+        EXPECT_NEAR(energyRatio(kind, 100.0, 20), 1.0, 1e-6);
+        break;
+      case LinearModel::Adaptive:  // follows the motion to its tolerance, whatever the interval
+        EXPECT_NEAR(energyRatio(kind, 1.0, 10), 1.0, 1e-3);
+        EXPECT_NEAR(energyRatio(kind, 30.0, 2), 1.0, 1e-3);
+        break;
+    }
+  }
 }
 
 }  // namespace

@@ -142,8 +142,8 @@ void ImplicitSystem::appendStatistics(std::vector<Statistic>& out) const {
   }
   if (solver_.kind() == LinearSolverKind::Cg) {
     add("cg_iterations", static_cast<double>(ls.cgIterations));
-    if (solver_.preconditioner() == PreconditionerKind::IncompleteCholesky ||
-        solver_.preconditioner() == PreconditionerKind::Factor) {
+    // The preconditioners that factor a matrix (ichol, factor) say how often.
+    if (ls.preconditionerFactorizations > 0) {
       add("preconditioner_factorizations", static_cast<double>(ls.preconditionerFactorizations));
     }
   }
