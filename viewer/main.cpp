@@ -30,20 +30,15 @@ std::filesystem::path defaultWorld() {
   return std::filesystem::path(JELLO_WORLDS_DIR) / "jello.w";
 }
 
-}  // namespace
+// The options that are not a ViewerOptions field as they stand.
+struct Args {
+  std::string world = defaultWorld().string(), integrator, size = "640x480", compare;
+  bool panel = false, noPanel = false;
+};
 
-int main(int argc, char** argv) {
-  jello::exitCleanlyWhenOutOfMemory("jello");
-  jello::applySolverThreadSettings(argv);
-  jello::leaveOneCpuFree();  // the drawing thread's (src/base/parallel.h)
-  jello::viewer::ViewerOptions opt;
-  std::string world = defaultWorld().string(), integrator, size = "640x480";
-  CLI::App app{"jello: the interactive jello cube (OpenGL/GLUT viewer)"};
-  app.footer("\nKeys and mouse:\n" + jello::viewer::keyTable() +
-             "\nExit codes: 0 done, 1 no display or a frame not written, 2 bad arguments or world, "
-             "3 diverged while recording.");
-  app.add_option("world", world, "World file")->capture_default_str();
-  app.add_option("--integrator", integrator,
+void addOptions(CLI::App& app, jello::viewer::ViewerOptions& opt, Args& args) {
+  app.add_option("world", args.world, "World file")->capture_default_str();
+  app.add_option("--integrator", args.integrator,
                  "Integrator, overriding the file's: " + jello::integratorNameList());
   app.add_option("--dt", opt.source.dt, "Time step (s), overriding the file's")
       ->check(jello::cli::positive());
@@ -59,12 +54,11 @@ int main(int argc, char** argv) {
       ->check(jello::cli::range(1, jello::viewer::kMaxRecordedFrames))
       ->needs(record);
   record->needs("--frames");
-  std::string compare;
-  app.add_option("--compare", compare,
+  app.add_option("--compare", args.compare,
                  "Run these integrators (2-6, comma-separated, e.g. rk4,implicit) side by side in "
                  "split panes, at one shared simulated time")
       ->excludes("--integrator");
-  app.add_option("--size", size, "Window size WxH in pixels")->capture_default_str();
+  app.add_option("--size", args.size, "Window size WxH in pixels")->capture_default_str();
   app.add_option("--speed", opt.speed,
                  "Playback speed: simulated seconds per wall second (also of a recording: "
                  "15 frames per speed simulated seconds)")
@@ -72,9 +66,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--course-time", opt.courseTime,
                "The original pacing: each displayed (or recorded) frame advances the world's n*dt");
-  bool panel = false, noPanel = false;
-  app.add_flag("--panel", panel, "Show the panel in recordings too (it is shown interactively)");
-  app.add_flag("--no-panel", noPanel, "Start with the panel hidden (key m shows it)")
+  app.add_flag("--panel", args.panel,
+               "Show the panel in recordings too (it is shown interactively)");
+  app.add_flag("--no-panel", args.noPanel, "Start with the panel hidden (key m shows it)")
       ->excludes("--panel");
   app.add_flag("--wireframe", opt.wireframe, "Start in wireframe mode");
   app.add_flag("--field", opt.field, "Start with the force-field arrows shown (key f)");
@@ -94,6 +88,69 @@ int main(int argc, char** argv) {
                  "Largest cube resolution a world may ask for")
       ->check(jello::cli::range(2, 256))
       ->capture_default_str();
+}
+
+// The --compare list into opt; a usage error's text, or empty.
+std::string applyCompare(const std::string& compare, jello::viewer::ViewerOptions& opt) {
+  std::stringstream list(compare);
+  for (std::string name; std::getline(list, name, ',');) {
+    const std::optional<jello::IntegratorKind> kind = jello::parseIntegratorName(name);
+    if (!kind) {
+      return "--compare: unknown integrator '" + name + "' (known: " + jello::integratorNameList() +
+             ")";
+    }
+    opt.compare.push_back(*kind);
+  }
+  if (opt.compare.size() < 2 || opt.compare.size() > 6) {
+    return "--compare wants 2 to 6 integrators, e.g. rk4,implicit, not '" + compare + "'";
+  }
+  return "";
+}
+
+// The options that need more than a check of their own into opt; a usage error's text, or empty.
+std::string apply(const Args& args, jello::viewer::ViewerOptions& opt) {
+  std::smatch m;
+  static const std::regex sizePattern(R"((\d{2,5})x(\d{2,5}))");
+  if (!std::regex_match(args.size, m, sizePattern)) {
+    return "--size wants WxH in pixels, e.g. 640x480, not '" + args.size + "'";
+  }
+  opt.size = {std::stoi(m[1]), std::stoi(m[2])};
+  if (opt.size.width < 16 || opt.size.height < 16 || opt.size.width > 8192 ||
+      opt.size.height > 8192) {
+    return "--size must be between 16x16 and 8192x8192";
+  }
+  if (!args.integrator.empty()) {
+    opt.source.integrator = jello::parseIntegratorName(args.integrator);
+    if (!opt.source.integrator) {
+      return "unknown integrator '" + args.integrator + "' (known: " + jello::integratorNameList() +
+             ")";
+    }
+  }
+  if (args.panel || args.noPanel) opt.panel = args.panel;
+  if (!opt.texture.empty() && opt.texture != "builtin") {
+    try {
+      (void)jello::viewer::loadTexture(opt.texture);
+    } catch (const std::exception& e) {
+      return std::string("--texture: ") + e.what();
+    }
+  }
+  if (!args.compare.empty()) return applyCompare(args.compare, opt);
+  return "";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  jello::exitCleanlyWhenOutOfMemory("jello");
+  jello::applySolverThreadSettings(argv);
+  jello::leaveOneCpuFree();  // the drawing thread's (src/base/parallel.h)
+  jello::viewer::ViewerOptions opt;
+  Args args;
+  CLI::App app{"jello: the interactive jello cube (OpenGL/GLUT viewer)"};
+  app.footer("\nKeys and mouse:\n" + jello::viewer::keyTable() +
+             "\nExit codes: 0 done, 1 no display or a frame not written, 2 bad arguments or world, "
+             "3 diverged while recording.");
+  addOptions(app, opt, args);
   try {
     app.parse(argc, argv);
     jello::refuseNonFiniteNumbers(app);
@@ -105,47 +162,8 @@ int main(int argc, char** argv) {
     std::cerr << "jello: error: " << message << "\n\n" << app.help();
     return kExitUsage;
   };
-  std::smatch m;
-  static const std::regex sizePattern(R"((\d{2,5})x(\d{2,5}))");
-  if (!std::regex_match(size, m, sizePattern)) {
-    return usageError("--size wants WxH in pixels, e.g. 640x480, not '" + size + "'");
-  }
-  opt.size = {std::stoi(m[1]), std::stoi(m[2])};
-  if (opt.size.width < 16 || opt.size.height < 16 || opt.size.width > 8192 ||
-      opt.size.height > 8192) {
-    return usageError("--size must be between 16x16 and 8192x8192");
-  }
-  if (!integrator.empty()) {
-    opt.source.integrator = jello::parseIntegratorName(integrator);
-    if (!opt.source.integrator) {
-      return usageError("unknown integrator '" + integrator +
-                        "' (known: " + jello::integratorNameList() + ")");
-    }
-  }
-  if (panel || noPanel) opt.panel = panel;
-  if (!opt.texture.empty() && opt.texture != "builtin") {
-    try {
-      (void)jello::viewer::loadTexture(opt.texture);
-    } catch (const std::exception& e) {
-      return usageError(std::string("--texture: ") + e.what());
-    }
-  }
-  if (!compare.empty()) {
-    std::stringstream list(compare);
-    for (std::string name; std::getline(list, name, ',');) {
-      const std::optional<jello::IntegratorKind> kind = jello::parseIntegratorName(name);
-      if (!kind) {
-        return usageError("--compare: unknown integrator '" + name +
-                          "' (known: " + jello::integratorNameList() + ")");
-      }
-      opt.compare.push_back(*kind);
-    }
-    if (opt.compare.size() < 2 || opt.compare.size() > 6) {
-      return usageError("--compare wants 2 to 6 integrators, e.g. rk4,implicit, not '" + compare +
-                        "'");
-    }
-  }
-  opt.source.world = world;
+  if (const std::string why = apply(args, opt); !why.empty()) return usageError(why);
+  opt.source.world = args.world;
   // With --integrator, a file naming an integrator we do not have still loads (with a warning).
   opt.source.limits.acceptUnknownIntegrator = opt.source.integrator.has_value();
   jello::World loaded;
@@ -158,7 +176,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr,
                  "jello: warning: %s names the integrator '%s', unknown here; stepping "
                  "with --integrator %s\n",
-                 world.c_str(), loaded.unknownIntegrator.c_str(), integrator.c_str());
+                 args.world.c_str(), loaded.unknownIntegrator.c_str(), args.integrator.c_str());
   }
   return jello::viewer::runViewer(opt, std::move(loaded));
 }

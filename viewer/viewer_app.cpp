@@ -138,6 +138,7 @@ void Viewer::capture(const std::filesystem::path& path) {
   writeJpeg(path, imageFromBottomUp(viewport_.width, viewport_.height, readBackBuffer(viewport_)));
 }
 
+// Long: one frame's drawing, pane by pane, in the order GL needs it.
 void Viewer::display() {
   if (recording()) waitForRecordedFrame();
   if (group_ && !recording()) {

@@ -7,6 +7,7 @@
 
 namespace jello::viewer::window {
 
+// Long: a switch with one case per command.
 void Viewer::key(unsigned char key) {
   if (panel_.key(key, lastX_, lastY_)) return glutPostRedisplay();  // typing into the panel
   const KeyResult result = handleKey(view_, key);

@@ -10,6 +10,7 @@
 
 namespace jello::viewer {
 
+// Long: a switch with one case per key.
 KeyResult handleKey(ViewerState& s, unsigned char key) {
   const auto integrators = allIntegrators();
   // Keys 1-9, then 0 for the tenth; n steps through all of them (and the panel lists them).

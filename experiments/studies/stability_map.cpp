@@ -7,16 +7,15 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <string>
+#include <variant>
+#include <vector>
 
-#include "experiments/common/signal_handler.h"
 #include "experiments/studies/csv_table.h"
-#include "experiments/studies/ranks.h"
-#include "experiments/studies/run_context.h"
 #include "experiments/studies/stability_analysis.h"
-#include "solvers/linalg/solver_threads.h"
+#include "experiments/studies/study.h"
 #include "solvers/simulation.h"
 #include "src/base/finite_options.h"
-#include "src/base/out_of_memory.h"
 
 namespace {
 
@@ -33,10 +32,6 @@ struct Options {
   double tolerance = 0.02;
   double dtMax = 0.05;  // s
   double rtol = 1e-3;   // cvode
-  int jobs = 1;         // set from Ranks::defaultJobs
-  std::string outDir = "experiments/results";
-  std::string name = "stability";
-  bool quick = false, quiet = false;
 };
 
 struct Point {
@@ -46,22 +41,7 @@ struct Point {
   double wMax;
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  const Ranks ranks(argc, argv);
-  if (!ranks.error().empty()) {
-    std::cerr << "jello-stability: error: " << ranks.error() << '\n';
-    return 1;
-  }
-  jello::exitCleanlyWhenOutOfMemory("jello-stability");
-  jello::ignoreBrokenPipes("jello-stability");
-  applySolverThreadSettings(argv);
-  Options opt;
-  opt.jobs = ranks.defaultJobs();
-  CLI::App app{
-      "jello-stability: largest stable time step per integrator and stiffness, "
-      "measured against predicted"};
+void addOptions(CLI::App& app, Options& opt) {
   app.add_option("--k", opt.ks, "Spring stiffnesses, N/m (default 10 to 1e6, 2 per decade)")
       ->check(jello::cli::positive())
       ->delimiter(',');
@@ -96,125 +76,131 @@ int main(int argc, char** argv) {
   app.add_option("--rtol", opt.rtol, "cvode's relative tolerance")
       ->check(jello::cli::positive())
       ->capture_default_str();
-  app.add_option("--jobs", opt.jobs, "Grid points run in parallel (per MPI rank)")
-      ->check(jello::cli::range(1, 256))
-      ->capture_default_str();
-  app.add_option("--out-dir", opt.outDir, "Directory for NAME.csv and NAME.json")
-      ->capture_default_str();
-  app.add_option("--name", opt.name, "File name stem")->capture_default_str();
-  app.add_flag("--quick", opt.quick,
-               "Small grid for CI: k = 100 and 10^4, free scene, 0.1 s, 5% bisection");
-  app.add_flag("--quiet", opt.quiet, "No progress line");
-  try {
-    app.parse(argc, argv);
-    jello::refuseNonFiniteNumbers(app);
-  } catch (const CLI::ParseError& e) {
-    // Under mpirun every rank parses the same line: rank 0 alone prints, all exit alike.
-    return (ranks.root() ? app.exit(e) : e.get_exit_code()) == 0 ? 0 : 2;
-  }
-  // The tree as the run starts: the code that ran (outputs written later do not count).
-  const nlohmann::json context = runContext(argc, argv);
-  // The output directory is made and checked before the (long) run.
-  if (!ranks.prepareOutput("jello-stability", opt.outDir, opt.name)) return 1;
+}
+
+// The integrators the options name (all when none), or the unknown name.
+std::variant<std::vector<IntegratorKind>, std::string> integrators(const Options& opt) {
   std::vector<IntegratorKind> kinds;
   for (const std::string& name : opt.integrators) {
     const auto kind = parseIntegratorName(name);
-    if (!kind) {
-      std::cerr << "jello-stability: error: unknown integrator '" << name
-                << "' (known: " << integratorNameList() << ")\n";
-      return 2;
-    }
+    if (!kind) return name;
     kinds.push_back(*kind);
   }
   if (kinds.empty()) kinds.assign(allIntegrators().begin(), allIntegrators().end());
-  if (opt.quick) {
-    if (app.count("--k") == 0) opt.ks = {1e2, 1e4};
-    if (app.count("--scenes") == 0) opt.scenes = {"free"};
-    if (app.count("--time") == 0) opt.rule.time = 0.1;
-    if (app.count("--min-steps") == 0) opt.rule.minSteps = 500;
-    if (app.count("--tolerance") == 0) opt.tolerance = 0.05;
+  return kinds;
+}
+
+// --quick's defaults where the options did not say, and the full grid's stiffnesses.
+void applyDefaults(const Study& study, Options& opt) {
+  if (study.quick) {
+    if (!study.given("--k")) opt.ks = {1e2, 1e4};
+    if (!study.given("--scenes")) opt.scenes = {"free"};
+    if (!study.given("--time")) opt.rule.time = 0.1;
+    if (!study.given("--min-steps")) opt.rule.minSteps = 500;
+    if (!study.given("--tolerance")) opt.tolerance = 0.05;
   }
   if (opt.ks.empty()) {
     for (int i = 2; i <= 12; ++i) opt.ks.push_back(std::pow(10.0, i / 2.0));
   }
+}
 
-  // The scenes and their w_max (serial: a Lanczos solve each, milliseconds).
+// The scenes and their w_max (serial: a Lanczos solve each, milliseconds).
+std::vector<Point> grid(const Options& opt) {
+  std::vector<Point> points;
+  for (const std::string& scene : opt.scenes) {
+    for (double k : opt.ks) {
+      World w = stabilityScene(scene, k, opt.dampingRatio, opt.contactRatio);
+      const Model model(w);
+      const double wMax = maxAngularFrequency(model, initialState(w));
+      points.push_back({scene, k, std::move(w), wMax});
+    }
+  }
+  return points;
+}
+
+// One grid point: the predicted threshold and the measured one, a row each.
+void measure(const Options& opt, const Point& p, IntegratorKind kind, const SolverOptions& solver,
+             CsvTable& table) {
+  const std::string name(integratorName(kind));
+  const double c = opt.dampingRatio * p.k, zeta = opt.dampingRatio * p.wMax / 2.0;
+  const double predicted = predictedThreshold(kind, p.wMax, opt.dampingRatio);
+  table.add({p.scene, name, p.k, c, p.wMax, zeta, std::string("predicted"), predicted,
+             predicted * p.wMax,
+             std::string(std::isinf(predicted) ? "unconditional"
+                         : predicted > 0.0     ? "limit"
+                                               : "never"),
+             0L, 0.0});
+  // The search starts at Courant number 1 for every method, not at its prediction, so the
+  // measurement does not lean on what it is compared with.
+  const double guess = 1.0 / p.wMax;
+  const auto t0 = std::chrono::steady_clock::now();
+  const Threshold t =
+      findThreshold(p.world, kind, opt.rule, guess, opt.dtMax, opt.tolerance, 1e-8, solver);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const std::string outcome = t.stableToMax()  ? "stable_to_max"
+                              : t.stable > 0.0 ? "threshold"
+                                               : "unstable_to_min";
+  table.add({p.scene, name, p.k, c, p.wMax, zeta, std::string("measured"), t.stable,
+             t.stable * p.wMax, outcome, long(t.trials), wall});
+}
+
+nlohmann::json parameters(const Options& opt, const Study& study) {
+  return {{"k_N_per_m", opt.ks},
+          {"scenes", opt.scenes},
+          {"damping_ratio_s", opt.dampingRatio},
+          {"wall_contact_ratio", opt.contactRatio},
+          {"blow_up",
+           {{"time_s", opt.rule.time},
+            {"explicit_min_steps", opt.rule.minSteps},
+            {"energy_factor", opt.rule.energyFactor},
+            {"energy_envelope_steps", kEnergyEnvelopeSteps},
+            {"divergence_bound_m", kDivergenceBound}}},
+          {"bisection_tolerance", opt.tolerance},
+          {"dt_max_s", opt.dtMax},
+          {"cvode_rtol", opt.rtol},
+          {"jobs", study.jobs},
+          {"quick", study.quick}};
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Study study("jello-stability",
+              "largest stable time step per integrator and stiffness, measured against predicted",
+              "stability", argc, argv);
+  Options opt;
+  addOptions(study.app(), opt);
+  study.addCommonOptions("Small grid for CI: k = 100 and 10^4, free scene, 0.1 s, 5% bisection");
+  std::vector<IntegratorKind> kinds;
+  const auto checked = study.start(argc, argv, [&]() -> std::string {
+    auto named = integrators(opt);
+    if (const std::string* unknown = std::get_if<std::string>(&named)) {
+      return "unknown integrator '" + *unknown + "' (known: " + integratorNameList() + ")";
+    }
+    kinds = std::get<std::vector<IntegratorKind>>(std::move(named));
+    return "";
+  });
+  if (checked) return *checked;
+  applyDefaults(study, opt);
+
   std::vector<Point> points;
   try {
-    for (const std::string& scene : opt.scenes) {
-      for (double k : opt.ks) {
-        World w = stabilityScene(scene, k, opt.dampingRatio, opt.contactRatio);
-        const Model model(w);
-        const double wMax = maxAngularFrequency(model, initialState(w));
-        points.push_back({scene, k, std::move(w), wMax});
-      }
-    }
+    points = grid(opt);
   } catch (const std::exception& e) {
-    std::cerr << "jello-stability: error: " << e.what() << '\n';
-    return 1;
+    return study.fail(e.what());
   }
-
   CsvTable table({"scene", "integrator", "k_N_per_m", "c_Ns_per_m", "w_max_rad_per_s", "zeta_max",
                   "source", "dt_s", "courant_number", "outcome", "trials", "wall_time_s"});
   SolverOptions solver;
   solver.cvode.rtol = opt.rtol;
   const int tasks = int(points.size() * kinds.size());
-  const auto started = std::chrono::steady_clock::now();
   const bool ok =
-      ranks.run("jello-stability", tasks, opt.jobs, "grid points", !opt.quiet,
+      study.run(tasks, "grid points",
                 [&](int i) {
                   const Point& p = points[static_cast<std::size_t>(i) / kinds.size()];
-                  const IntegratorKind kind = kinds[static_cast<std::size_t>(i) % kinds.size()];
-                  const std::string name(integratorName(kind));
-                  const double c = opt.dampingRatio * p.k, zeta = opt.dampingRatio * p.wMax / 2.0;
-                  const double predicted = predictedThreshold(kind, p.wMax, opt.dampingRatio);
-                  table.add({p.scene, name, p.k, c, p.wMax, zeta, std::string("predicted"),
-                             predicted, predicted * p.wMax,
-                             std::string(std::isinf(predicted) ? "unconditional"
-                                         : predicted > 0.0     ? "limit"
-                                                               : "never"),
-                             0L, 0.0});
-                  // The search starts at Courant number 1 for every method, not at its prediction,
-                  // so the measurement does not lean on what it is compared with.
-                  const double guess = 1.0 / p.wMax;
-                  const auto t0 = std::chrono::steady_clock::now();
-                  const Threshold t = findThreshold(p.world, kind, opt.rule, guess, opt.dtMax,
-                                                    opt.tolerance, 1e-8, solver);
-                  const double wall =
-                      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-                  const std::string outcome = t.stableToMax()  ? "stable_to_max"
-                                              : t.stable > 0.0 ? "threshold"
-                                                               : "unstable_to_min";
-                  table.add({p.scene, name, p.k, c, p.wMax, zeta, std::string("measured"), t.stable,
-                             t.stable * p.wMax, outcome, long(t.trials), wall});
+                  measure(opt, p, kinds[static_cast<std::size_t>(i) % kinds.size()], solver, table);
                 },
                 {&table});
   if (!ok) return 1;
-
-  nlohmann::json sidecar = context;
-  sidecar["program"] = "jello-stability";
-  sidecar["parameters"] = {{"k_N_per_m", opt.ks},
-                           {"scenes", opt.scenes},
-                           {"damping_ratio_s", opt.dampingRatio},
-                           {"wall_contact_ratio", opt.contactRatio},
-                           {"blow_up",
-                            {{"time_s", opt.rule.time},
-                             {"explicit_min_steps", opt.rule.minSteps},
-                             {"energy_factor", opt.rule.energyFactor},
-                             {"energy_envelope_steps", kEnergyEnvelopeSteps},
-                             {"divergence_bound_m", kDivergenceBound}}},
-                           {"bisection_tolerance", opt.tolerance},
-                           {"dt_max_s", opt.dtMax},
-                           {"cvode_rtol", opt.rtol},
-                           {"jobs", opt.jobs},
-                           {"quick", opt.quick}};
-  sidecar["wall_time_s"] =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  const std::filesystem::path dir = opt.outDir;
-  if (!ranks.writeOutput("jello-stability", dir, opt.name, table, sidecar)) return 1;
-  if (!opt.quiet && ranks.root()) {
-    std::printf("wrote %zu rows to %s (%.1f s)\n", table.rows(),
-                (dir / (opt.name + ".csv")).c_str(), sidecar["wall_time_s"].get<double>());
-  }
-  return 0;
+  return study.finish(table, parameters(opt, study));
 }

@@ -105,13 +105,20 @@ void warnOfLightlyDampedStiffness(const Simulation& sim, double simulated, doubl
                w->wMax, w->dampingRatio, w->steps, simulated, jello::kCvodeStepTimesWmax);
 }
 
-int run(const Options& opt) {
-  // Every output is checked before the run (an I/O failure, found before it starts).
-  std::vector<jello::PlannedOutput> outputs;
-  if (opt.outGiven) outputs.push_back({"--out", opt.out});
-  if (opt.statsGiven) outputs.push_back({"--stats", opt.stats});
-  if (opt.traceGiven) outputs.push_back({"--trace", opt.trace});
-  if (!jello::checkOutputs("jello-sim", outputs)) return kExitInput;
+// What a run came to: the steps done, its wall time, and why it stopped early if it did.
+struct Outcome {
+  long total = 0;  // steps asked for
+  long done = 0;   // steps taken (a diverged step not counted)
+  double wall = 0.0;
+  bool diverged = false;
+  int interrupted = 0;  // the signal that stopped it
+  std::string failure;  // a step that could not run (a resource limit), not a divergence
+  jello::Energy start, end;
+  jello::Vec3 startL, endL;
+};
+
+// The world of the command line, its integrator overridable; nothing after an error (said).
+std::optional<jello::World> loadWorld(const Options& opt) {
   jello::World world;
   try {
     jello::ReaderLimits limits = opt.limits;
@@ -119,7 +126,7 @@ int run(const Options& opt) {
     world = jello::readWorld(opt.world, limits);
   } catch (const jello::WorldFileError& e) {
     std::fprintf(stderr, "jello-sim: error: %s\n", e.what());
-    return kExitInput;
+    return std::nullopt;
   }
   if (!world.unknownIntegrator.empty()) {
     std::fprintf(stderr,
@@ -128,28 +135,20 @@ int run(const Options& opt) {
                  opt.world.c_str(), world.unknownIntegrator.c_str(), opt.integrator.c_str());
   }
   if (opt.cube) world = jello::resampleCube(world, *opt.cube);
+  return world;
+}
 
-  std::optional<jello::IntegratorKind> kind;
-  if (!opt.integrator.empty()) {
-    kind = jello::parseIntegratorName(opt.integrator);
-    if (!kind) {
-      std::fprintf(stderr, "jello-sim: error: unknown integrator '%s' (known: %s)\n",
-                   opt.integrator.c_str(), jello::integratorNameList().c_str());
-      return kExitUsage;
-    }
-  }
-  const double kElastic = world.kElastic, dElastic = world.dElastic;
-  Simulation sim(std::move(world), kind, opt.dt, opt.solver);
+// The steps --time or --steps ask for, or nothing (said) when there are too many. A --time that
+// is not a whole number of steps ends past it, never short of it: a note says by how much.
+std::optional<long> stepCount(const Options& opt, const Simulation& sim) {
   const double dt = sim.dt();
   const double wanted =
       opt.steps ? double(*opt.steps) : std::ceil(opt.time.value_or(1.0) / dt - 1e-9);
   if (!(wanted <= 1e12)) {  // also catches an overflowing quotient before the cast to long
     std::fprintf(stderr, "jello-sim: error: %.3g steps asked for; at most 1e12 per run\n", wanted);
-    return kExitUsage;
+    return std::nullopt;
   }
   const long total = static_cast<long>(wanted);
-  // --time not a multiple of dt: the run takes whole steps and ends past the time asked for
-  // (never short of it); say so, and by how much, before it starts.
   if (!opt.steps && opt.time && !opt.quiet) {
     const double end = sim.state().t + double(total) * dt, asked = sim.state().t + *opt.time;
     if (std::abs(end - asked) > 1e-9 * std::max(1.0, std::abs(asked))) {
@@ -159,109 +158,115 @@ int run(const Options& opt) {
                    *opt.time, dt, total, end, end - asked);
     }
   }
-  if (jello::integratorFamily(sim.integratorKind()) == jello::IntegratorFamily::Cvode &&
-      !opt.quiet) {
-    warnOfLightlyDampedStiffness(sim, opt.steps ? double(total) * dt : opt.time.value_or(1.0),
-                                 kElastic, dElastic);
-  }
-  const Energy start = sim.model().energy(sim.state());
-  const jello::Vec3 startL = sim.model().angularMomentum(sim.state());
-  const std::string name(jello::integratorName(sim.integratorKind()));
+  return total;
+}
 
-  Trace trace(!opt.trace.empty());
+// Steps until `total`, a divergence, a failure or a signal (SIGINT, SIGTERM and SIGHUP stop at
+// a step boundary; the stats and the trace are written), tracing every opt.every steps.
+void stepAll(Simulation& sim, const Options& opt, Trace& trace, Outcome& o) {
+  const std::string name(jello::integratorName(sim.integratorKind()));
   trace.row(sim);
   jello::Progress progress(!opt.quiet, name + " steps");
   const auto t0 = std::chrono::steady_clock::now();
-  bool diverged = false;
-  std::string failure;  // a step that could not run (a resource limit), not a divergence
-  // SIGHUP (the terminal closed) stops like SIGTERM: the stats and the trace are written.
   for (int signo : {SIGINT, SIGTERM, SIGHUP})
     jello::setSignalHandler("jello-sim", signo, onInterrupt);
-  for (long i = 0; i < total && interruptSignal == 0; ++i) {
+  for (long i = 0; i < o.total && interruptSignal == 0; ++i) {
     if (const jello::StepResult r = sim.step(); !r.ok) {
-      if (r.resource) failure = r.message;
-      diverged = !r.interrupted && !r.resource;  // both leave the state at the step's start
+      if (r.resource) o.failure = r.message;
+      o.diverged = !r.interrupted && !r.resource;  // both leave the state at the step's start
       break;
     }
     if (sim.steps() % opt.every == 0) trace.row(sim);
-    progress.update(i + 1, total);
+    progress.update(i + 1, o.total);
   }
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  o.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (int signo : {SIGINT, SIGTERM, SIGHUP}) jello::setSignalHandler("jello-sim", signo, SIG_DFL);
-  const int interrupted = interruptSignal;
+  o.interrupted = interruptSignal;
   progress.finish();
+  o.done = o.diverged ? sim.steps() - 1 : sim.steps();
+  o.end = sim.model().energy(sim.state());
+  o.endL = sim.model().angularMomentum(sim.state());
+}
 
+// The summary as JSON (--stats), and on stderr what went wrong: unconverged steps, a signal, a
+// failure, a divergence.
+nlohmann::json statistics(const Options& opt, const Simulation& sim, const Outcome& o) {
   const jello::State& s = sim.state();
-  const long done = diverged ? sim.steps() - 1 : sim.steps();
-  const Energy end = sim.model().energy(s);
-  const jello::Vec3 endL = sim.model().angularMomentum(s);
   nlohmann::json stats = {
       {"world", opt.world},
-      {"integrator", name},
-      {"dt_s", dt},
+      {"integrator", std::string(jello::integratorName(sim.integratorKind()))},
+      {"dt_s", sim.dt()},
       {"points", s.numPoints()},
       {"springs", sim.model().springs().numSprings()},
-      {"steps", done},
+      {"steps", o.done},
       {"simulated_time_s", s.t},
-      {"wall_time_s", wall},
-      {"steps_per_s", wall > 0 ? double(done) / wall : 0.0},
-      {"real_time_factor", wall > 0 ? s.t / wall : 0.0},
-      {"energy_start", toJson(start)},
-      {"energy_end", toJson(end)},
-      {"angular_momentum_start_kg_m2_per_s", {startL.x, startL.y, startL.z}},
-      {"angular_momentum_end_kg_m2_per_s", {endL.x, endL.y, endL.z}},
-      {"diverged", diverged},
-      {"interrupted", interrupted != 0},
+      {"wall_time_s", o.wall},
+      {"steps_per_s", o.wall > 0 ? double(o.done) / o.wall : 0.0},
+      {"real_time_factor", o.wall > 0 ? s.t / o.wall : 0.0},
+      {"energy_start", toJson(o.start)},
+      {"energy_end", toJson(o.end)},
+      {"angular_momentum_start_kg_m2_per_s", {o.startL.x, o.startL.y, o.startL.z}},
+      {"angular_momentum_end_kg_m2_per_s", {o.endL.x, o.endL.y, o.endL.z}},
+      {"diverged", o.diverged},
+      {"interrupted", o.interrupted != 0},
   };
-  const std::vector<jello::Statistic> solverStats = sim.integrator().statistics();
-  for (const jello::Statistic& st : solverStats) stats["solver"][st.name] = st.value;
-  for (const jello::Statistic& st : solverStats) {
+  for (const jello::Statistic& st : sim.integrator().statistics()) {
+    stats["solver"][st.name] = st.value;
     if (st.name == "newton_unconverged_steps" && st.value > 0) {
       std::fprintf(stderr,
                    "jello-sim: warning: %.0f of %ld steps did not converge within %d Newton "
                    "iterations (raise --newton-iters or --newton-tol; but where a point meets a "
                    "wall or an obstacle at speed the contact's damping force jumps and the "
                    "step's equations may have no root: README, \"implicit\")\n",
-                   st.value, done, opt.solver.implicit.newtonMaxIterations);
+                   st.value, o.done, opt.solver.implicit.newtonMaxIterations);
     }
   }
-  if (interrupted) {
+  if (o.interrupted) {
     std::fprintf(stderr, "jello-sim: interrupted (signal %d) at t = %g s, after step %ld of %ld\n",
-                 interrupted, s.t, done, total);
+                 o.interrupted, s.t, o.done, o.total);
   }
-  if (!failure.empty()) {
-    stats["failure"] = failure;
-    std::fprintf(stderr, "jello-sim: error: %s\n", failure.c_str());
+  if (!o.failure.empty()) {
+    stats["failure"] = o.failure;
+    std::fprintf(stderr, "jello-sim: error: %s\n", o.failure.c_str());
   }
-  if (diverged) {
+  if (o.diverged) {
     const jello::Divergence& d = *sim.divergence();
     stats["divergence"] = {{"time_s", d.time}, {"step", d.step}, {"reason", d.reason}};
     std::fprintf(stderr, "jello-sim: %s\n", d.describe().c_str());
   }
+  return stats;
+}
 
-  if (!opt.quiet) {
-    std::printf("world        %s (%d points, %d springs)\n", opt.world.c_str(), s.numPoints(),
-                sim.model().springs().numSprings());
-    std::printf("integrator   %s, dt = %g s\n", name.c_str(), dt);
-    std::printf("steps        %ld%s\n", done,
-                diverged           ? " (then diverged)"
-                : interrupted      ? " (interrupted)"
-                : !failure.empty() ? " (then stopped: see the error above)"
+void printSummary(const Options& opt, const Simulation& sim, const Outcome& o) {
+  const jello::State& s = sim.state();
+  const std::string name(jello::integratorName(sim.integratorKind()));
+  std::printf("world        %s (%d points, %d springs)\n", opt.world.c_str(), s.numPoints(),
+              sim.model().springs().numSprings());
+  std::printf("integrator   %s, dt = %g s\n", name.c_str(), sim.dt());
+  std::printf("steps        %ld%s\n", o.done,
+              o.diverged           ? " (then diverged)"
+              : o.interrupted      ? " (interrupted)"
+              : !o.failure.empty() ? " (then stopped: see the error above)"
                                    : "");
-    std::printf("simulated    %.6g s\n", s.t);
-    std::printf("wall time    %.3f s (%.0f steps/s, %.2fx real time)\n", wall,
-                wall > 0 ? double(done) / wall : 0.0, wall > 0 ? s.t / wall : 0.0);
-    std::printf("energy (J)   %12s %12s %12s %12s\n", "kinetic", "spring", "contact", "total");
-    std::printf("  start      %12.6g %12.6g %12.6g %12.6g\n", start.kinetic, start.spring,
-                start.contact, start.total());
-    std::printf("  %-10s %12.6g %12.6g %12.6g %12.6g\n", diverged ? "last sane" : "end",
-                end.kinetic, end.spring, end.contact, end.total());
-    for (const jello::Statistic& st : solverStats) {
-      std::printf("  %-28s %.6g\n", st.name.c_str(), st.value);
-    }
+  std::printf("simulated    %.6g s\n", s.t);
+  std::printf("wall time    %.3f s (%.0f steps/s, %.2fx real time)\n", o.wall,
+              o.wall > 0 ? double(o.done) / o.wall : 0.0, o.wall > 0 ? s.t / o.wall : 0.0);
+  std::printf("energy (J)   %12s %12s %12s %12s\n", "kinetic", "spring", "contact", "total");
+  std::printf("  start      %12.6g %12.6g %12.6g %12.6g\n", o.start.kinetic, o.start.spring,
+              o.start.contact, o.start.total());
+  std::printf("  %-10s %12.6g %12.6g %12.6g %12.6g\n", o.diverged ? "last sane" : "end",
+              o.end.kinetic, o.end.spring, o.end.contact, o.end.total());
+  for (const jello::Statistic& st : sim.integrator().statistics()) {
+    std::printf("  %-28s %.6g\n", st.name.c_str(), st.value);
   }
+}
 
-  // Every output that can be written is: one failing does not lose the others.
+// Every output that can be written is: one failing does not lose the others. A diverged,
+// interrupted or failed run saves no world (its last state is not the state at the requested
+// time); its trace and stats are complete up to where it stopped, and say so. False when a
+// write failed.
+bool writeOutputs(const Options& opt, const Simulation& sim, const Outcome& o, const Trace& trace,
+                  const nlohmann::json& stats) {
   bool writeFailed = false;
   const auto attempt = [&](auto&& write) {
     try {
@@ -271,37 +276,68 @@ int run(const Options& opt) {
       writeFailed = true;
     }
   };
+  const bool complete = !o.diverged && !o.interrupted && o.failure.empty();
   if (!opt.trace.empty()) attempt([&] { jello::writeFileAtomically(opt.trace, trace.text()); });
   if (!opt.stats.empty()) {
     attempt([&] { jello::writeFileAtomically(opt.stats, stats.dump(2) + "\n"); });
   }
-  // A diverged or interrupted run saves no world: its last state is not the state at the
-  // requested time. Its trace and stats are complete up to where it stopped, and say so.
-  if (!opt.out.empty() && !diverged && !interrupted && failure.empty()) {
+  if (!opt.out.empty() && complete)
     attempt([&] { jello::writeWorld(sim.currentWorld(), opt.out); });
-  }
-  if (writeFailed) return kExitInput;
-  if ((diverged || interrupted || !failure.empty()) && !opt.out.empty()) {
+  if (writeFailed) return false;
+  if (!complete && !opt.out.empty()) {
     std::fprintf(stderr, "jello-sim: %s not written (the simulation %s)\n", opt.out.c_str(),
-                 diverged      ? "diverged"
-                 : interrupted ? "was interrupted"
-                               : "could not go on");
+                 o.diverged      ? "diverged"
+                 : o.interrupted ? "was interrupted"
+                                 : "could not go on");
   }
-  if (!failure.empty()) return kExitInput;
-  if (interrupted) return 128 + interrupted;
-  return diverged ? kExitDiverged : 0;
+  return true;
 }
 
-}  // namespace
+int run(const Options& opt) {
+  // Every output is checked before the run (an I/O failure, found before it starts).
+  std::vector<jello::PlannedOutput> outputs;
+  if (opt.outGiven) outputs.push_back({"--out", opt.out});
+  if (opt.statsGiven) outputs.push_back({"--stats", opt.stats});
+  if (opt.traceGiven) outputs.push_back({"--trace", opt.trace});
+  if (!jello::checkOutputs("jello-sim", outputs)) return kExitInput;
+  std::optional<jello::World> world = loadWorld(opt);
+  if (!world) return kExitInput;
+  std::optional<jello::IntegratorKind> kind;
+  if (!opt.integrator.empty()) {
+    kind = jello::parseIntegratorName(opt.integrator);
+    if (!kind) {
+      std::fprintf(stderr, "jello-sim: error: unknown integrator '%s' (known: %s)\n",
+                   opt.integrator.c_str(), jello::integratorNameList().c_str());
+      return kExitUsage;
+    }
+  }
+  const double kElastic = world->kElastic, dElastic = world->dElastic;
+  Simulation sim(std::move(*world), kind, opt.dt, opt.solver);
+  Outcome o;
+  if (const std::optional<long> total = stepCount(opt, sim)) {
+    o.total = *total;
+  } else {
+    return kExitUsage;
+  }
+  if (jello::integratorFamily(sim.integratorKind()) == jello::IntegratorFamily::Cvode &&
+      !opt.quiet) {
+    warnOfLightlyDampedStiffness(
+        sim, opt.steps ? double(o.total) * sim.dt() : opt.time.value_or(1.0), kElastic, dElastic);
+  }
+  o.start = sim.model().energy(sim.state());
+  o.startL = sim.model().angularMomentum(sim.state());
+  Trace trace(!opt.trace.empty());
+  stepAll(sim, opt, trace, o);
+  const nlohmann::json stats = statistics(opt, sim, o);
+  if (!opt.quiet) printSummary(opt, sim, o);
+  if (!writeOutputs(opt, sim, o, trace, stats)) return kExitInput;
+  if (!o.failure.empty()) return kExitInput;
+  if (o.interrupted) return 128 + o.interrupted;
+  return o.diverged ? kExitDiverged : 0;
+}
 
-int main(int argc, char** argv) {
-  jello::exitCleanlyWhenOutOfMemory("jello-sim");
-  jello::ignoreBrokenPipes("jello-sim");
-  jello::applySolverThreadSettings(argv);
-  // A file-size limit (or a quota) must fail the write, which is reported and cleaned up, not
-  // kill the process with a temporary file left behind.
-  jello::setSignalHandler("jello-sim", SIGXFSZ, SIG_IGN);
-  Options opt;
+// The command line into opt; an exit code when the program stops here (--help, bad usage).
+std::optional<int> parseCommandLine(int argc, char** argv, Options& opt) {
   CLI::App app{
       "Steps a jello world headless and prints a summary: steps, simulated and wall time, "
       "steps/s, real-time factor, energy at start and end, and the solver's statistics. For "
@@ -339,7 +375,6 @@ int main(int argc, char** argv) {
       ->check(jello::cli::range(2, 256))
       ->capture_default_str()
       ->group("Limits (checked before memory is allocated)");
-
   jello::SolverFlags solverFlags;
   jello::addSolverFlags(app, solverFlags);
   try {
@@ -353,5 +388,19 @@ int main(int argc, char** argv) {
   opt.outGiven = app.count("--out") > 0;
   opt.statsGiven = app.count("--stats") > 0;
   opt.traceGiven = app.count("--trace") > 0;
+  return std::nullopt;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  jello::exitCleanlyWhenOutOfMemory("jello-sim");
+  jello::ignoreBrokenPipes("jello-sim");
+  jello::applySolverThreadSettings(argv);
+  // A file-size limit (or a quota) must fail the write, which is reported and cleaned up, not
+  // kill the process with a temporary file left behind.
+  jello::setSignalHandler("jello-sim", SIGXFSZ, SIG_IGN);
+  Options opt;
+  if (const std::optional<int> code = parseCommandLine(argc, argv, opt)) return *code;
   return run(opt);
 }

@@ -29,6 +29,7 @@ std::vector<std::string> namesOf(std::span<const Kind> kinds, Name name) {
 
 }  // namespace
 
+// Long: the table of jello-sim's solver flags, one option each.
 void addSolverFlags(CLI::App& app, SolverFlags& f) {
   auto& implicit = f.solver.implicit;
   auto& cvode = f.solver.cvode;

@@ -122,35 +122,62 @@ bool CvodeIntegrator::continues(const Model& model, const State& s) const {
   return s.x == lastX_ && s.v == lastV_;
 }
 
+namespace {
+
+StepResult check(const char* call, int flag) {
+  return flag == CV_SUCCESS ? StepResult::success() : StepResult::failure(cvodeError(call, flag));
+}
+
+}  // namespace
+
 StepResult CvodeIntegrator::start(const Model& model, const State& s) {
   const bool sameModel = cvode_ && modelId_ == model.id();
   model_ = &model;
   modelId_ = model.id();
   n3_ = 3 * model.numPoints();
   if (!sameModel) {
-    carryCounters();
-    cvode_.reset();
-    linearSolver_.reset();
-    matrix_.reset();
-    y_.reset();
-    nonlinearSolver_.reset();
-    atol_.reset();
-    context_.reset();
-    SUNContext ctx = nullptr;
-    if (SUNContext_Create(nullptr, &ctx) != 0) return StepResult::failure("SUNContext_Create");
-    context_.reset(ctx);
-    y_.reset(N_VNew_Serial(2 * n3_, ctx));
-    atol_.reset(N_VNew_Serial(2 * n3_, ctx));
-    if (!y_ || !atol_) return StepResult::failure("N_VNew_Serial failed");
-    // CVODE clones its work vectors from y_: they inherit the faster loops.
-    if (options_.fastVectors &&
-        (!installFastOperations(y_.get()) || !installFastOperations(atol_.get()))) {
-      return StepResult::failure("the serial vectors' operations could not be replaced");
-    }
-    // A new model: the system rebuilds its pattern and its solver analyses afresh.
-    system_.bind(model);
-    b_.setZero(n3_);
+    if (StepResult r = newContext(model); !r.ok) return r;
   }
+  load(s);
+  assembled_ = false;
+  preconditionerReady_ = false;
+  restartPending_ = false;
+  ++restarts_;
+  if (sameModel) {
+    carryCounters();
+    return check("CVodeReInit", CVodeReInit(cvode_.get(), s.t, y_.get()));
+  }
+  if (StepResult r = configure(s); !r.ok) return r;
+  return attachSolvers();
+}
+
+StepResult CvodeIntegrator::newContext(const Model& model) {
+  carryCounters();
+  cvode_.reset();
+  linearSolver_.reset();
+  matrix_.reset();
+  y_.reset();
+  nonlinearSolver_.reset();
+  atol_.reset();
+  context_.reset();
+  SUNContext ctx = nullptr;
+  if (SUNContext_Create(nullptr, &ctx) != 0) return StepResult::failure("SUNContext_Create");
+  context_.reset(ctx);
+  y_.reset(N_VNew_Serial(2 * n3_, ctx));
+  atol_.reset(N_VNew_Serial(2 * n3_, ctx));
+  if (!y_ || !atol_) return StepResult::failure("N_VNew_Serial failed");
+  // CVODE clones its work vectors from y_: they inherit the faster loops.
+  if (options_.fastVectors &&
+      (!installFastOperations(y_.get()) || !installFastOperations(atol_.get()))) {
+    return StepResult::failure("the serial vectors' operations could not be replaced");
+  }
+  // A new model: the system rebuilds its pattern and its solver analyses afresh.
+  system_.bind(model);
+  b_.setZero(n3_);
+  return StepResult::success();
+}
+
+void CvodeIntegrator::load(const State& s) {
   // Positions relative to the centre of mass of the start.
   const int n = n3_ / 3;
   shift_.resize(n3_);
@@ -161,18 +188,10 @@ StepResult CvodeIntegrator::start(const Model& model, const State& s) {
   lastX_ = s.x;
   lastV_ = s.v;
   t_ = s.t;
-  assembled_ = false;
-  preconditionerReady_ = false;
-  restartPending_ = false;
-  ++restarts_;
+}
 
-  if (sameModel) {
-    carryCounters();
-    if (int f = CVodeReInit(cvode_.get(), s.t, y_.get()); f != CV_SUCCESS) {
-      return StepResult::failure(cvodeError("CVodeReInit", f));
-    }
-    return StepResult::success();
-  }
+// CVODE's memory with its tolerances, limits and root functions (every return code checked).
+StepResult CvodeIntegrator::configure(const State& s) {
   const bool adams = options_.method == CvodeMethod::Adams;
   cvode_.reset(CVodeCreate(adams ? CV_ADAMS : CV_BDF, context_.get()));
   if (!cvode_) return StepResult::failure("CVodeCreate failed");
@@ -185,9 +204,6 @@ StepResult CvodeIntegrator::start(const Model& model, const State& s) {
   std::fill(atol, atol + n3_, options_.atolPosition > 0.0 ? options_.atolPosition : fallback);
   std::fill(atol + n3_, atol + 2 * n3_,
             options_.atolVelocity > 0.0 ? options_.atolVelocity : fallback);
-  auto check = [](const char* call, int flag) {
-    return flag == CV_SUCCESS ? StepResult::success() : StepResult::failure(cvodeError(call, flag));
-  };
   for (const StepResult& r :
        {check("CVodeInit", CVodeInit(mem, rhsTrampoline, s.t, y_.get())),
         check("CVodeSVtolerances", CVodeSVtolerances(mem, options_.rtol, atol_.get())),
@@ -202,18 +218,20 @@ StepResult CvodeIntegrator::start(const Model& model, const State& s) {
     if (StepResult r = check("CVodeSetStabLimDet", flag); !r.ok) return r;
   }
   if (options_.contactRoots && numRootFunctions() > 0) {
-    if (StepResult r =
-            check("CVodeRootInit", CVodeRootInit(mem, numRootFunctions(), rootTrampoline));
-        !r.ok) {
-      return r;
-    }
+    return check("CVodeRootInit", CVodeRootInit(mem, numRootFunctions(), rootTrampoline));
   }
-  if (adams) {
+  return StepResult::success();
+}
+
+// Adams: fixed-point iterations. BDF: SPGMR preconditioned by the reduced system, or the
+// reduced system solved exactly as a custom DIRECT solver (docs: dependencies.md's pitfalls).
+StepResult CvodeIntegrator::attachSolvers() {
+  void* mem = cvode_.get();
+  if (options_.method == CvodeMethod::Adams) {
     nonlinearSolver_.reset(SUNNonlinSol_FixedPoint(y_.get(), 0, context_.get()));
     if (!nonlinearSolver_) return StepResult::failure("SUNNonlinSol_FixedPoint failed");
     return check("CVodeSetNonlinearSolver", CVodeSetNonlinearSolver(mem, nonlinearSolver_.get()));
   }
-
   if (usesKrylov()) {
     linearSolver_.reset(SUNLinSol_SPGMR(y_.get(), SUN_PREC_LEFT, 0, context_.get()));
     if (!linearSolver_) return StepResult::failure("SUNLinSol_SPGMR failed");

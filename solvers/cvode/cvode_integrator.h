@@ -54,7 +54,13 @@ class CvodeIntegrator final : public Integrator {
   static constexpr std::size_t kNumCounters = 10;
 
  private:
+  // (Re)starts CVODE at `state`: a new model gets a new context, vectors and memory
+  // (newContext, then configure and attachSolvers), the same one a CVodeReInit.
   StepResult start(const Model& model, const State& state);
+  StepResult newContext(const Model& model);
+  void load(const State& state);  // y = (x - the centre of mass at the start, v)
+  StepResult configure(const State& state);
+  StepResult attachSolvers();
   bool continues(const Model& model, const State& state) const;
   // Adds CVODE's counters to carried_ before CVodeReInit or a new CVODE zeroes them.
   void carryCounters();

@@ -235,6 +235,7 @@ StepResult SpdSolver::setUpPreconditioner(const SparseMatrix& A) {
   return StepResult::success();
 }
 
+// Long: one preconditioned CG iteration loop, each preconditioner's application inline in it.
 StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
   Impl& s = *impl_;
   const Eigen::Index n3 = b.size(), n = n3 / 3;

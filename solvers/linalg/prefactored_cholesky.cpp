@@ -111,6 +111,8 @@ long PrefactoredCholesky::nonZeros() const {
   return nonZeros_;
 }
 
+// Long: CHOLMOD's analysis, the factorization and the choice of copy in the order CHOLMOD needs
+// them, each return code checked.
 StepResult PrefactoredCholesky::factorize(const SparseMatrix& A,
                                           const PrefactoredCholesky* samePattern) {
   Impl& s = *impl_;
@@ -246,6 +248,8 @@ void PrefactoredCholesky::blockCopy(bool samePattern) {
   impl_->lanes.resize(static_cast<std::size_t>(n_));
 }
 
+// Long: the rank update by cholmod_updown and the refill of every copy of the factor it changed,
+// in one transaction.
 StepResult PrefactoredCholesky::addToDiagonal(const std::vector<std::pair<int, double>>& changes) {
   Impl& s = *impl_;
   if (!factored()) return StepResult::failure("prefactored Cholesky: no factor to update");

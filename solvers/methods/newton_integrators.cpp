@@ -127,6 +127,8 @@ StepResult NewtonIntegrator::seed(const Model& model, double inertia, double h) 
   return StepResult::success();
 }
 
+// Long: one step's Newton loop (seeds, factor reuse, line search, stopping tests) read top to
+// bottom.
 StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
   bind(model);
   this->form(model, s, h, form_);

@@ -143,6 +143,7 @@ StepResult ProjectiveIntegrator::factorChanged(double h) {
   return StepResult::success();
 }
 
+// Long: one step's local/global loop, fused with the force evaluation for speed.
 StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
   bind(model);
   const std::ptrdiff_t n = n_, size = 3 * n;

@@ -53,6 +53,7 @@ std::optional<Penetration> conePenetration(const Cone& cone, const Vec3& x) {
   return p;
 }
 
+// Long: the six faces' depths and the nearest one's gradient and Hessian.
 std::optional<Penetration> spiralPenetration(const Spiral& s, const Vec3& x) {
   const double px = x.x - s.cx, py = x.y - s.cy;
   const double r = std::hypot(px, py);

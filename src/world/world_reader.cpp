@@ -28,10 +28,6 @@ std::string metres(double value) {
   return buf;
 }
 
-bool isExtensionKeyword(std::string_view s) {
-  return s == "integrator" || s == "cube" || s == "sphere" || s == "cone" || s == "spiral";
-}
-
 bool looksNumeric(std::string_view s) {
   const char c = s.front();
   return (c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.';
@@ -46,86 +42,116 @@ bool completeCube(std::size_t count) {
   return n >= 2 && n * n * n == points;
 }
 
-// Reads the extension block: one keyword per entry, each at most once.
+// The extension keywords (worlds/FORMAT.md), one row each: what follows the keyword is read by
+// its function into the world. Each may appear once.
+void readIntegratorExtension(Tokenizer& in, World& world, const ReaderLimits& limits) {
+  const Token name = in.next();
+  if (name.text.empty()) in.fail(name, "file ends where an integrator name was expected");
+  if (const auto kind = parseIntegratorName(name.text)) {
+    world.integrator = *kind;
+    world.unknownIntegrator.clear();
+  } else if (limits.acceptUnknownIntegrator) {
+    world.unknownIntegrator = std::string(name.text);  // the caller overrides it
+  } else {
+    in.fail(name, "unknown integrator (known: " + integratorNameList() +
+                      "; --integrator on the command line overrides it)");
+  }
+}
+
+void readCubeExtension(Tokenizer& in, World& world, const ReaderLimits& limits) {
+  const int n = in.integer("cube resolution");
+  if (n < 2 || n > limits.maxCubeResolution) {
+    in.fail(in.lastToken(),
+            "cube resolution must be between 2 and " + std::to_string(limits.maxCubeResolution));
+  }
+  world.cubeResolution = n;
+}
+
+void readSphereExtension(Tokenizer& in, World& world, const ReaderLimits&) {
+  Sphere s;
+  s.center.x = in.number("sphere centre x");
+  s.center.y = in.number("sphere centre y");
+  s.center.z = in.number("sphere centre z");
+  s.radius = in.positive("sphere radius");
+  world.sphere = s;
+}
+
+void readConeExtension(Tokenizer& in, World& world, const ReaderLimits&) {
+  Cone c;
+  c.apex.x = in.number("cone apex x");
+  c.apex.y = in.number("cone apex y");
+  c.apex.z = in.number("cone apex z");
+  c.axis.x = in.number("cone axis x");
+  c.axis.y = in.number("cone axis y");
+  c.axis.z = in.number("cone axis z");
+  if (c.axis.x == 0.0 && c.axis.y == 0.0 && c.axis.z == 0.0) {
+    in.fail(in.lastToken(), "the cone's axis must not be zero");
+  }
+  c.height = in.positive("cone height");
+  c.radius = in.positive("cone base radius");
+  world.cone = c;
+}
+
+void readSpiralExtension(Tokenizer& in, World& world, const ReaderLimits&) {
+  Spiral s;
+  s.cx = in.number("spiral axis x");
+  s.cy = in.number("spiral axis y");
+  s.zTop = in.number("spiral top height");
+  s.rInner = in.number("spiral inner radius");
+  if (s.rInner < 0.0) in.fail(in.lastToken(), "the spiral's inner radius must be >= 0");
+  s.rOuter = in.positive("spiral outer radius");
+  if (!(s.rOuter > s.rInner)) {
+    in.fail(in.lastToken(), "the spiral's outer radius must exceed its inner radius");
+  }
+  s.pitch = in.positive("spiral pitch");
+  s.turns = in.positive("spiral turns");
+  if (s.turns > 100.0) in.fail(in.lastToken(), "the spiral has at most 100 turns");
+  s.thickness = in.positive("spiral thickness");
+  if (!(s.thickness < s.pitch)) {
+    in.fail(in.lastToken(), "the spiral's thickness must be less than its pitch");
+  }
+  world.spiral = s;
+}
+
+struct Extension {
+  std::string_view keyword;
+  void (*read)(Tokenizer&, World&, const ReaderLimits&);
+};
+constexpr Extension kExtensions[] = {
+    {"integrator", readIntegratorExtension}, {"cube", readCubeExtension},
+    {"sphere", readSphereExtension},         {"cone", readConeExtension},
+    {"spiral", readSpiralExtension},
+};
+
+const Extension* extension(std::string_view keyword) {
+  for (const Extension& e : kExtensions) {
+    if (e.keyword == keyword) return &e;
+  }
+  return nullptr;
+}
+
+// "integrator, cube, sphere, cone, spiral": for the messages about unknown content.
+std::string extensionKeywords() {
+  std::string list;
+  for (const Extension& e : kExtensions)
+    list += (list.empty() ? "" : ", ") + std::string(e.keyword);
+  return list;
+}
+
+// Reads the extension block from `keyword` on: one keyword per entry, each at most once.
 void readExtensions(Tokenizer& in, Token keyword, World& world, const ReaderLimits& limits) {
-  bool seenCube = false;
-  bool seenSphere = false, seenCone = false, seenSpiral = false;
-  bool seenIntegrator = false;
+  std::vector<std::string_view> seen;
   while (!keyword.text.empty()) {
-    if (keyword.text == "integrator") {
-      if (seenIntegrator) in.fail(keyword, "extension 'integrator' given twice");
-      seenIntegrator = true;
-      const Token name = in.next();
-      if (name.text.empty()) in.fail(name, "file ends where an integrator name was expected");
-      if (const auto kind = parseIntegratorName(name.text)) {
-        world.integrator = *kind;
-        world.unknownIntegrator.clear();
-      } else if (limits.acceptUnknownIntegrator) {
-        world.unknownIntegrator = std::string(name.text);  // the caller overrides it
-      } else {
-        in.fail(name, "unknown integrator (known: " + integratorNameList() +
-                          "; --integrator on the command line overrides it)");
-      }
-    } else if (keyword.text == "cube") {
-      if (seenCube) in.fail(keyword, "extension 'cube' given twice");
-      seenCube = true;
-      const int n = in.integer("cube resolution");
-      if (n < 2 || n > limits.maxCubeResolution) {
-        in.fail(in.lastToken(), "cube resolution must be between 2 and " +
-                                    std::to_string(limits.maxCubeResolution));
-      }
-      world.cubeResolution = n;
-    } else if (keyword.text == "sphere") {
-      if (seenSphere) in.fail(keyword, "extension 'sphere' given twice");
-      seenSphere = true;
-      Sphere s;
-      s.center.x = in.number("sphere centre x");
-      s.center.y = in.number("sphere centre y");
-      s.center.z = in.number("sphere centre z");
-      s.radius = in.positive("sphere radius");
-      world.sphere = s;
-    } else if (keyword.text == "cone") {
-      if (seenCone) in.fail(keyword, "extension 'cone' given twice");
-      seenCone = true;
-      Cone c;
-      c.apex.x = in.number("cone apex x");
-      c.apex.y = in.number("cone apex y");
-      c.apex.z = in.number("cone apex z");
-      c.axis.x = in.number("cone axis x");
-      c.axis.y = in.number("cone axis y");
-      c.axis.z = in.number("cone axis z");
-      if (c.axis.x == 0.0 && c.axis.y == 0.0 && c.axis.z == 0.0) {
-        in.fail(in.lastToken(), "the cone's axis must not be zero");
-      }
-      c.height = in.positive("cone height");
-      c.radius = in.positive("cone base radius");
-      world.cone = c;
-    } else if (keyword.text == "spiral") {
-      if (seenSpiral) in.fail(keyword, "extension 'spiral' given twice");
-      seenSpiral = true;
-      Spiral s;
-      s.cx = in.number("spiral axis x");
-      s.cy = in.number("spiral axis y");
-      s.zTop = in.number("spiral top height");
-      s.rInner = in.number("spiral inner radius");
-      if (s.rInner < 0.0) in.fail(in.lastToken(), "the spiral's inner radius must be >= 0");
-      s.rOuter = in.positive("spiral outer radius");
-      if (!(s.rOuter > s.rInner)) {
-        in.fail(in.lastToken(), "the spiral's outer radius must exceed its inner radius");
-      }
-      s.pitch = in.positive("spiral pitch");
-      s.turns = in.positive("spiral turns");
-      if (s.turns > 100.0) in.fail(in.lastToken(), "the spiral has at most 100 turns");
-      s.thickness = in.positive("spiral thickness");
-      if (!(s.thickness < s.pitch)) {
-        in.fail(in.lastToken(), "the spiral's thickness must be less than its pitch");
-      }
-      world.spiral = s;
-    } else {
+    const Extension* e = extension(keyword.text);
+    if (!e) {
       in.fail(keyword,
-              "unknown trailing content (extension keywords: integrator, cube, sphere, cone, "
-              "spiral)");
+              "unknown trailing content (extension keywords: " + extensionKeywords() + ")");
     }
+    if (std::find(seen.begin(), seen.end(), e->keyword) != seen.end()) {
+      in.fail(keyword, "extension '" + std::string(e->keyword) + "' given twice");
+    }
+    seen.push_back(e->keyword);
+    e->read(in, world, limits);
     keyword = in.next();
   }
 }
@@ -168,9 +194,8 @@ WorldFileError::WorldFileError(std::string file, int line, std::string token,
 
 namespace {
 
-World parseTokens(Tokenizer& in, const ReaderLimits& limits) {
-  World w;
-
+// The integrator, the time step, the constants, the mass and the plane.
+void readHeader(Tokenizer& in, const ReaderLimits& limits, World& w) {
   const Token integrator = in.next();
   if (integrator.text.empty()) in.fail(integrator, "empty file: no integrator name");
   const auto kind = parseIntegratorName(integrator.text);
@@ -211,34 +236,36 @@ World parseTokens(Tokenizer& in, const ReaderLimits& limits) {
     if (p.a == 0.0 && p.b == 0.0 && p.c == 0.0) in.fail(first, "the plane normal (a,b,c) is zero");
     w.plane = p;
   }
+}
 
+void readField(Tokenizer& in, const ReaderLimits& limits, World& w) {
   const int res = in.integer("the force-field resolution");
   const Token resToken = in.lastToken();
   if (res < 0 || res == 1 || res > limits.maxFieldResolution) {
     in.fail(resToken, "force-field resolution must be 0 (none) or between 2 and " +
                           std::to_string(limits.maxFieldResolution));
   }
-  if (res > 0) {
-    const std::size_t nodes = static_cast<std::size_t>(res) * res * res;
-    // Each of the 3*nodes numbers needs at least a digit and a separator: refuse before
-    // allocating when the file cannot hold them.
-    if (in.remainingBytes() < nodes * 3 * 2 - 1) {
-      in.fail(resToken, "file is too short for a force field of resolution " + std::to_string(res) +
-                            " (" + std::to_string(nodes) + " nodes)");
-    }
-    w.field.resolution = res;
-    w.field.forces.resize(nodes);  // at most 128^3 nodes (50 MB), and the file holds them
-    for (Vec3& f : w.field.forces) {
-      f.x = in.number("force-field x");
-      f.y = in.number("force-field y");
-      f.z = in.number("force-field z");
-    }
+  if (res == 0) return;
+  const std::size_t nodes = static_cast<std::size_t>(res) * res * res;
+  // Each of the 3*nodes numbers needs at least a digit and a separator: refuse before
+  // allocating when the file cannot hold them.
+  if (in.remainingBytes() < nodes * 3 * 2 - 1) {
+    in.fail(resToken, "file is too short for a force field of resolution " + std::to_string(res) +
+                          " (" + std::to_string(nodes) + " nodes)");
   }
+  w.field.resolution = res;
+  w.field.forces.resize(nodes);  // at most 128^3 nodes (50 MB), and the file holds them
+  for (Vec3& f : w.field.forces) {
+    f.x = in.number("force-field x");
+    f.y = in.number("force-field y");
+    f.z = in.number("force-field z");
+  }
+}
 
-  // Positions and velocities: their count depends on the cube resolution, which an extension
-  // given after them may set, so collect numbers up to the first keyword.
-  std::vector<double> values;
-  TokenLog tokens;
+// Positions and velocities: their count depends on the cube resolution, which an extension
+// given after them may set, so the numbers are collected up to the first keyword, returned.
+Token readCubeNumbers(Tokenizer& in, const ReaderLimits& limits, std::vector<double>& values,
+                      TokenLog& tokens) {
   values.reserve(6 * 512);
   tokens.reserve(6 * 512);
   // The largest cube the limits allow bounds how many numbers can follow: refused at the first
@@ -246,30 +273,34 @@ World parseTokens(Tokenizer& in, const ReaderLimits& limits) {
   const std::size_t largest = static_cast<std::size_t>(limits.maxCubeResolution);
   const std::size_t maxValues = 6 * largest * largest * largest;
   Token t = in.next();
-  while (!t.text.empty() && !isExtensionKeyword(t.text)) {
+  while (!t.text.empty() && !extension(t.text)) {
     if (values.size() == maxValues) {
       in.fail(t, "more numbers than the positions and velocities of the largest cube allowed (" +
                      std::to_string(largest) + "^3 points: " + std::to_string(maxValues) +
                      " numbers)");
     }
     if (completeCube(values.size()) && !looksNumeric(t.text)) {
-      in.fail(t,
-              "unknown trailing content after the velocities (extension keywords: integrator, "
-              "cube, sphere, cone, spiral)");
+      in.fail(t, "unknown trailing content after the velocities (extension keywords: " +
+                     extensionKeywords() + ")");
     }
     values.push_back(in.toNumber(t, "a position or velocity"));
     tokens.add(t);
     t = in.next();
   }
-  readExtensions(in, t, w, limits);
+  return t;
+}
 
+// The cube's positions and velocities from the numbers read, once its resolution is known: as
+// many as it has points, each start one the simulation would not call diverged at once.
+void assignCube(Tokenizer& in, const std::vector<double>& values, const TokenLog& tokens,
+                int lastLine, World& w) {
   const std::size_t points = static_cast<std::size_t>(w.numPoints());
   const std::size_t expected = 6 * points;
   if (values.size() < expected) {
     const bool inPositions = values.size() < 3 * points;
     const std::string block = inPositions ? "positions" : "velocities";
     const std::size_t got = inPositions ? values.size() : values.size() - 3 * points;
-    const Token where{{}, 0, tokens.empty() ? t.line : tokens.back().line};
+    const Token where{{}, 0, tokens.empty() ? lastLine : tokens.back().line};
     in.fail(where, "truncated: " + std::to_string(got / 3) + " of " + std::to_string(points) + " " +
                        block + " (cube resolution " + std::to_string(w.cubeResolution) + ")");
   }
@@ -284,7 +315,6 @@ World parseTokens(Tokenizer& in, const ReaderLimits& limits) {
     w.positions[p] = {values[3 * p], values[3 * p + 1], values[3 * p + 2]};
     const std::size_t q = 3 * (points + p);
     w.velocities[p] = {values[q], values[q + 1], values[q + 2]};
-    // A start the simulation would call diverged at once is refused here, naming its line.
     const Vec3& x = w.positions[p];
     if (std::hypot(x.x, x.y, x.z) > kStartBound) {
       in.fail(tokens[3 * p], "point " + std::to_string(p) + " starts " +
@@ -298,7 +328,11 @@ World parseTokens(Tokenizer& in, const ReaderLimits& limits) {
               "point " + std::to_string(p) + "'s velocity gives it an infinite kinetic energy");
     }
   }
-  // Two points at one place: the springs between them would have no direction (0/0).
+}
+
+// Two points at one place: the springs between them would have no direction (0/0).
+void refuseCoincidentPoints(Tokenizer& in, const TokenLog& tokens, const World& w) {
+  const std::size_t points = w.positions.size();
   std::vector<std::size_t> order(points);
   for (std::size_t p = 0; p < points; ++p) order[p] = p;
   const auto key = [&](std::size_t p) {
@@ -317,6 +351,18 @@ World parseTokens(Tokenizer& in, const ReaderLimits& limits) {
                                  "have no direction");
     }
   }
+}
+
+World parseTokens(Tokenizer& in, const ReaderLimits& limits) {
+  World w;
+  readHeader(in, limits, w);
+  readField(in, limits, w);
+  std::vector<double> values;
+  TokenLog tokens;
+  const Token keyword = readCubeNumbers(in, limits, values, tokens);
+  readExtensions(in, keyword, w, limits);
+  assignCube(in, values, tokens, keyword.line, w);
+  refuseCoincidentPoints(in, tokens, w);
   return w;
 }
 

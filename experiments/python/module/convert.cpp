@@ -167,6 +167,7 @@ bool boolOption(const py::handle& v, const std::string& name) {
   return v.cast<bool>();
 }
 
+// Long: one branch per keyword option: the Python options' table, read in one place.
 jello::SolverOptions solverOptionsFrom(const py::kwargs& kwargs, jello::SolverOptions o) {
   std::optional<double> atol;
   for (const auto& [key, value] : kwargs) {

@@ -22,6 +22,7 @@ using jello::python::positive;
 using jello::python::solverOptionsFrom;
 using jello::python::valueError;
 
+// Long: the module's table of functions, one def each.
 PYBIND11_MODULE(_core, m) {
   m.doc() = "jello's simulator core; use it through the jello package (README \"From Python\")";
   py::register_exception_translator(&jello::python::translateExceptions);

@@ -296,6 +296,7 @@ py::object csr(const jello::SparseMatrix& m) {
 }
 }  // namespace
 
+// Long: the class's table of methods and properties, one def each.
 void bindSimulation(py::module_& m) {
   py::class_<ViewGuard>(m, "_StateView");
 

@@ -96,6 +96,7 @@ void saveWorld(const World& w, const std::string& path, bool legacy) {
 
 namespace {
 
+// Long: one branch per keyword, as jello-create-world's flags.
 // jello-create-world's flags as keywords ('-' -> '_'): the same presets, and the same check
 // that the world reads back.
 World createWorld(const py::kwargs& kwargs) {
@@ -205,6 +206,7 @@ World createWorld(const py::kwargs& kwargs) {
 
 }  // namespace
 
+// Long: the class's table of attributes and functions, one def each.
 void bindWorlds(py::module_& m) {
   // ---- World
   py::class_<World>(m, "World",
