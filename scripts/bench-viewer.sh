@@ -11,7 +11,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 frames=${1:-1200}
-scripts/build.sh release >/dev/null
+scripts/build.sh native >/dev/null
 export OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1
 out=experiments/results/viewer_fps.json
 tmp=$(mktemp)
@@ -21,7 +21,7 @@ bench() {  # name, world, args...
   shift 2
   echo "bench-viewer: $name" >&2
   local line
-  line=$(env ${BENCH_ENV:-} xvfb-run -a -s "-screen 0 1024x768x24" build/release/bin/jello \
+  line=$(env ${BENCH_ENV:-} xvfb-run -a -s "-screen 0 1024x768x24" build/native/bin/jello \
     "$world" "$@")
   echo "$line" >&2
   printf '%s\t%s\n' "$name" "$line" >>"$tmp"

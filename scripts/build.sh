@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Configures (once, or again when JELLO_WERROR is set) and builds one CMake preset: release
-# (default), debug, asan or fuzz. Programs land in build/<preset>/bin.
+# (default: runs on any x86-64), native (-march=native: benchmarks), debug, asan or fuzz.
+# Programs land in build/<preset>/bin.
 # JELLO_WERROR=ON (as CI sets it) turns compiler warnings into errors.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -7,19 +7,19 @@ step as the reference, and writes experiments/results/integrators.csv (one row p
 with a JSON sidecar. With --readme it also rewrites the table in README.md between the markers
 <!-- integrators-table:begin --> and <!-- integrators-table:end --> from that CSV alone.
 
-    scripts/integrator-table.py [--readme] [--no-run] [--bin build/release/bin]
+    scripts/integrator-table.py [--readme] [--no-run] [--bin build/native/bin]
 
 The second README table, the cost of one step of each implicit integrator, comes from
 experiments/results/implicit_steps.json, and the third, wall time per simulated second against
 RK4 (projective's crossover), from experiments/results/crossover.json; Google Benchmark writes
 both:
-    OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 0 build/release/bin/benchmarks \
+    OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 0 build/native/bin/benchmarks \
       --benchmark_filter=ImplicitIntegratorStep --benchmark_min_time=0.2 \
       --benchmark_out=experiments/results/implicit_steps.json --benchmark_out_format=json
-    OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 0 build/release/bin/benchmarks \
+    OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 0 build/native/bin/benchmarks \
       --benchmark_filter='Crossover|CvodeOneSecond/rtol1e3' \
       --benchmark_out=experiments/results/crossover.json --benchmark_out_format=json
-    OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 0 build/release/bin/benchmarks \
+    OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1 taskset -c 0 build/native/bin/benchmarks \
       --benchmark_filter=KeptFactorSolve --benchmark_repetitions=3 \
       --benchmark_out=experiments/results/kept_factor.json --benchmark_out_format=json
 """
@@ -296,7 +296,7 @@ def duration_fine(ms):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--bin", default=os.path.join(ROOT, "build", "release", "bin"))
+    parser.add_argument("--bin", default=os.path.join(ROOT, "build", "native", "bin"))
     parser.add_argument("--readme", action="store_true", help="rewrite README's table only")
     parser.add_argument("--no-run", action="store_true", help="use the committed CSV")
     args = parser.parse_args()

@@ -17,7 +17,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
-bin=build/release/bin
+bin=build/native/bin  # -march=native: the committed results and figures (README)
 out=experiments/results
 args=()
 stability_scenes='free wall'
@@ -46,7 +46,7 @@ if [ "${1:-}" = charts ]; then
   echo "run-experiments: charts redrawn in $out/"
   exit 0
 fi
-scripts/build.sh release >/dev/null
+scripts/build.sh native >/dev/null
 # Committed results come from a clean tree: each sidecar records its commit, which must be the
 # code that ran. JELLO_ALLOW_DIRTY=1 runs anyway (the sidecars then say "tree_modified": true).
 if [ "$out" = experiments/results ] && [ -z "${JELLO_ALLOW_DIRTY:-}" ] &&

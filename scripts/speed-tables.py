@@ -26,7 +26,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 JSON = os.path.join(ROOT, "experiments", "results", "speed.json")
 # Both cores: BM_Threads, run without taskset (1 and 2 threads in the same run).
 THREADS_JSON = os.path.join(ROOT, "experiments", "results", "speed_threads.json")
-BINARY = os.path.join(ROOT, "build", "release", "bin", "benchmarks")
+# The native build (-march=native): the README's speed figures are this machine's best.
+BINARY = os.path.join(ROOT, "build", "native", "bin", "benchmarks")
 FILTER = ("BM_SpringForces|BM_Step/|BM_Refill|BM_Factorize|BM_Solve/|BM_CgSolve|BM_SystemProduct|"
           "BM_ImplicitStep/|BM_StiffOneSecond")
 # BM_CgSolve's preconditioner argument is its row in the table (solvers/linalg/linear_solver.h).

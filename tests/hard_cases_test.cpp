@@ -176,11 +176,14 @@ INSTANTIATE_TEST_SUITE_P(Named, HardCaseTest, ::testing::ValuesIn(hardCases()),
 // Midpoint and the trapezoidal rule (newmark) add no artificial damping, and on these violently
 // nonlinear stiff cases (a spring strained 100%, h w_max up to 1,000) that is their undoing:
 // neither conserves energy for nonlinear springs, and both gained 1.5x to 58,000x of it in 2 s
-// (measured, README). What they must still do is stay finite: a run ends, diverged or not,
-// with every state it kept finite. The largest energy ratio and penetration are printed.
+// (measured, README). What they must still do: every state they keep is finite and within the
+// divergence rule's energy bound (10 times the start's, + 1 J: a growth past it is reported as a
+// divergence, never kept), contact holds (measured at most 3.6 mm deep, asserted under 1 cm),
+// and on the cube thrown into a wall, which they run to the end, the energy stays within 3x
+// its start (measured 1.0 midpoint, 2.26 newmark).
 class HardCaseUndamped : public ::testing::TestWithParam<std::tuple<int, IntegratorKind>> {};
 
-TEST_P(HardCaseUndamped, NeverLeavesANonFiniteState) {
+TEST_P(HardCaseUndamped, KeepsOnlyFiniteStatesWithinTheEnergyBound) {
   const auto [index, kind] = GetParam();
   const HardCase c = hardCases()[static_cast<std::size_t>(index)];
   Simulation sim(c.world, kind, c.dt);
@@ -193,9 +196,12 @@ TEST_P(HardCaseUndamped, NeverLeavesANonFiniteState) {
     deepest = std::max(deepest, deepestPenetration(sim.model(), sim.state()));
   }
   ASSERT_TRUE(sim.state().x.allFinite() && sim.state().v.allFinite());
-  std::printf("%s on %s: largest energy ratio %.3g, deepest %.3g m over %.3g s%s\n",
-              std::string(integratorName(kind)).c_str(), c.name.c_str(), worst, deepest,
-              sim.state().t, sim.divergence() ? " (diverged)" : "");
+  EXPECT_LE(worst, kEnergyGrowthFactor + kEnergyFloor / e0) << "a kept state above the bound";
+  EXPECT_LE(deepest, 0.01) << "m inside an obstacle";
+  if (c.name.find("Thrown") != std::string::npos) {
+    EXPECT_FALSE(sim.divergence().has_value());
+    EXPECT_LE(worst, 3.0);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(

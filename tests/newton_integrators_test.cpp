@@ -273,9 +273,8 @@ TEST(NewtonIntegrators, SeedingWithProjectiveIterationsGivesTheSameConvergedStep
       if (s.name == "newton_iterations") newtonA = s.value;
     }
     EXPECT_GT(seeds, 0.0);
-    if (kind == IntegratorKind::Implicit) {
-      EXPECT_LT(newtonB, newtonA);
-    }
+    // Measured 80 -> 63 (implicit), 85 -> 51 (midpoint), 80 -> 50 (newmark), 76 -> 45 (bdf2).
+    EXPECT_LT(newtonB, newtonA);
     std::printf("%s: Newton iterations %g plain, %g after %g seed iterations\n",
                 std::string(integratorName(kind)).c_str(), newtonA, newtonB, seeds);
   }

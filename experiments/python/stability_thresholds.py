@@ -75,17 +75,18 @@ def main():
     elapsed = time.monotonic() - started
 
     committed = committed_thresholds(COMMITTED)
-    # Bisection on the same blow-up rule: equal up to the last bits, which differ between CPUs
-    # (libm and vector code paths), never by a bisection step (1-5%).
+    # Bisection on the same blow-up rule to the same 2%: a build for another CPU level than the
+    # committed run's differs in the last bits, and where the rule's decision sits at the
+    # threshold those move the bisection within its resolution (equal to 1e-9 on one build).
     same = [key for key in measured
-            if key in committed and abs(committed[key] - measured[key]) <= 1e-9 * committed[key]]
+            if key in committed and abs(committed[key] - measured[key]) <= 0.02 * committed[key]]
     compared = [key for key in measured if key in committed]
     print(f"{len(measured)} thresholds in {elapsed:.1f} s on {args.jobs} threads")
     print(f"{'integrator':>11} {'k (N/m)':>10} {'dt (s)':>12} {'h w_max':>8} {'predicted':>10}")
     for (i, k), dt in sorted(measured.items(), key=lambda item: (item[0][0], item[0][1])):
         predicted = jello.predicted_threshold(i, w_max[k], DAMPING_RATIO) * w_max[k]
         print(f"{i:>11} {k:>10.3g} {dt:>12.5g} {dt * w_max[k]:>8.4f} {predicted:>10.4f}")
-    print(f"equal to the committed stability.csv (to 1e-9 relative): {len(same)} of "
+    print(f"equal to the committed stability.csv (within the bisection's 2%): {len(same)} of "
           f"{len(compared)} thresholds compared")
 
     fig, ax = plt.subplots(figsize=(9, 6.2))

@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "src/base/assertions.h"
+#include "src/base/vector_clones.h"
 
 // Without AVX-512 (a generic build) GCC warns that passing these vectors by value changes the
 // ABI: they never leave this file.
@@ -182,14 +183,14 @@ int DenseTail::copyTail(const cholmod_factor& L, int n) {
   return start;
 }
 
-void DenseTail::forward(double* y, int columns) const {
+JELLO_VECTOR_CLONES void DenseTail::forward(double* y, int columns) const {
   JELLO_ASSERT(columns >= 1 && columns <= 3, "one to three right-hand sides");
   if (columns == 1) return forwardPanels<1>(data_, paddedWidth_, y);
   if (columns == 2) return forwardPanels<2>(data_, paddedWidth_, y);
   forwardPanels<3>(data_, paddedWidth_, y);
 }
 
-void DenseTail::backward(double* y, int columns) const {
+JELLO_VECTOR_CLONES void DenseTail::backward(double* y, int columns) const {
   JELLO_ASSERT(columns >= 1 && columns <= 3, "one to three right-hand sides");
   if (columns == 1) return backwardPanels<1>(data_, paddedWidth_, y);
   if (columns == 2) return backwardPanels<2>(data_, paddedWidth_, y);

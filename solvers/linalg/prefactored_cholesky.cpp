@@ -16,12 +16,13 @@ namespace jello {
 namespace {
 
 // Three right-hand sides and a pad, one vector register (AVX) per point.
-using Lanes = double __attribute__((vector_size(32)));
+using Lanes = SubstitutionLanes;
+// Their storage: 32-byte aligned (vector<Lanes> cannot carry Lanes' reduced alignment).
+using AlignedLanes = double __attribute__((vector_size(32)));
 
 // Doubles from one point's entries to the next in the substitutions: one right-hand side
 // (T = double) uses the first, three the first three.
 constexpr int kStride = kSubstitutionStride;
-static_assert(sizeof(Lanes) == kStride * sizeof(double));
 
 // Forward substitution L y = y, then backward L^T z = y, in place (point i's entries at
 // yd + kStride i, `columns` of them): the supernodes before the tail push their solved values
@@ -69,7 +70,7 @@ struct PrefactoredCholesky::Impl {
   SingleSupernodes supernodes;
   DiagonalCorrection correction;  // the diagonal's changes on top of the single-precision factor
   std::vector<int> inversePerm;
-  std::vector<Lanes> lanes;
+  std::vector<AlignedLanes> lanes;
   SupernodeBlocks blocks;             // the copy's supernodes before the tail
   DenseTail tail;                     // the copy's last supernodes, when it pays (dense_tail.h)
   std::vector<double> tailBlock;      // its triangle from an updated factor, by columns
@@ -391,7 +392,7 @@ StepResult PrefactoredCholesky::solveFactored(double* b, int columns) const {
     for (int k = 0; k < n; ++k) b[perm_[k]] = y[kStride * k];
     return StepResult::success();
   }
-  Lanes* y = s.lanes.data();
+  Lanes* y = reinterpret_cast<Lanes*>(s.lanes.data());
   for (int k = 0; k < n; ++k) {
     const int p = perm_[k];
     y[k] = Lanes{b[p], columns > 1 ? b[n + p] : 0.0, columns > 2 ? b[2 * n + p] : 0.0, 0.0};

@@ -1,17 +1,15 @@
 #include "solvers/linalg/single_supernodes.h"
 
 #include <cholmod.h>
-#ifdef __AVX__
-#include <immintrin.h>
-#endif
 
 #include <algorithm>
 #include <cstring>
 
 #include "src/base/assertions.h"
+#include "src/base/vector_clones.h"
 
-// Without AVX (JELLO_NATIVE off, a generic x86-64 build) GCC warns that passing these vectors
-// by value changes the ABI: they never leave this file.
+// Without AVX (the default build's generic clone, src/base/vector_clones.h) GCC warns that
+// passing these vectors by value changes the ABI: they never leave this file.
 #pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace jello {
@@ -39,19 +37,23 @@ struct VectorOf<8> {
 template <int W>
 using Doubles = typename VectorOf<W>::type;
 
+// W floats widened to doubles: one conversion instruction where the target has it (vcvtps2pd,
+// AVX and AVX-512), the compiler's choice otherwise.
+template <int W>
+struct FloatsOf;
+template <>
+struct FloatsOf<4> {
+  using type = float __attribute__((vector_size(16)));
+};
+template <>
+struct FloatsOf<8> {
+  using type = float __attribute__((vector_size(32)));
+};
 template <int W>
 inline Doubles<W> widen(const float* p) {
-#ifdef __AVX512F__
-  if constexpr (W == 8) return Doubles<8>(_mm512_cvtps_pd(_mm256_loadu_ps(p)));
-#endif
-#ifdef __AVX__
-  if constexpr (W == 4) return Doubles<4>(_mm256_cvtps_pd(_mm_loadu_ps(p)));  // one instruction,
-#endif  // where the generic conversion below compiles to four
-  float f[W];
-  std::memcpy(f, p, sizeof f);
-  Doubles<W> d;
-  for (int i = 0; i < W; ++i) d[i] = double(f[i]);
-  return d;
+  typename FloatsOf<W>::type f;
+  std::memcpy(&f, p, sizeof f);
+  return __builtin_convertvector(f, Doubles<W>);
 }
 template <int W>
 inline Doubles<W> load(const double* p) {
@@ -346,7 +348,7 @@ void SingleSupernodes::copy(const cholmod_factor& L, int n) {
   f.y.resize(3 * static_cast<std::size_t>(n));
 }
 
-void SingleSupernodes::solve(int columns) {
+JELLO_VECTOR_CLONES void SingleSupernodes::solve(int columns) {
   JELLO_ASSERT(columns >= 1 && columns <= 3, "one to three right-hand sides");
   switch (columns) {
     case 1:

@@ -5,13 +5,13 @@
 
 #include "solvers/linalg/dense_tail.h"
 #include "src/base/assertions.h"
+#include "src/base/vector_clones.h"
 
 namespace jello {
 namespace {
 
-using Lanes = double __attribute__((vector_size(32)));
+using Lanes = SubstitutionLanes;
 constexpr int kStride = kSubstitutionStride;
-static_assert(sizeof(Lanes) == kStride * sizeof(double));
 constexpr int kChunk = DenseTail::kPanel;  // what invertLowerTriangle writes
 
 // One chunk of W <= 8 of a supernode's columns, their values y_c in `chunk` (held in
@@ -94,7 +94,7 @@ void SupernodeBlocks::sweep(int sn, double* yd) const {
   }
 }
 
-void SupernodeBlocks::forward(int columns, double* yd) const {
+JELLO_VECTOR_CLONES void SupernodeBlocks::forward(int columns, double* yd) const {
   const int supernodes = static_cast<int>(start.size()) - 1;
   for (int sn = 0; sn < supernodes; ++sn) {
     if (columns == 1) {
@@ -105,7 +105,7 @@ void SupernodeBlocks::forward(int columns, double* yd) const {
   }
 }
 
-void SupernodeBlocks::backward(int columns, double* yd) const {
+JELLO_VECTOR_CLONES void SupernodeBlocks::backward(int columns, double* yd) const {
   for (int sn = static_cast<int>(start.size()) - 2; sn >= 0; --sn) {
     if (columns == 1) {
       sweep<double, false>(sn, yd);

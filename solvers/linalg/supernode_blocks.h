@@ -18,6 +18,11 @@ namespace jello {
 // Doubles from one point's entries to the next in the substitutions' workspace: up to three
 // right-hand sides and a pad, one 4-wide vector per point.
 inline constexpr int kSubstitutionStride = 4;
+// One point's entries of the right-hand sides (three and a pad) as one vector. Aligned like a
+// double: the substitutions read them in place from arrays of doubles, whose 32-byte alignment
+// nothing guarantees (a clone compiled for AVX-512 used aligned moves on them and faulted).
+using SubstitutionLanes = double __attribute__((vector_size(32), aligned(8)));
+static_assert(sizeof(SubstitutionLanes) == kSubstitutionStride * sizeof(double));
 
 class SupernodeBlocks {
  public:

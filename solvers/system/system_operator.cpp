@@ -4,6 +4,7 @@
 
 #include "src/base/assertions.h"
 #include "src/base/parallel.h"
+#include "src/base/vector_clones.h"
 
 namespace jello {
 
@@ -79,8 +80,9 @@ void SystemOperator::apply(const double* p, double* y) const {
       [](std::ptrdiff_t, std::ptrdiff_t) {});
 }
 
-void SystemOperator::applyRange(const double* p, double* y, std::ptrdiff_t setLo,
-                                std::ptrdiff_t setHi, std::ptrdiff_t lo, std::ptrdiff_t hi) const {
+JELLO_VECTOR_CLONES void SystemOperator::applyRange(const double* p, double* y,
+                                                    std::ptrdiff_t setLo, std::ptrdiff_t setHi,
+                                                    std::ptrdiff_t lo, std::ptrdiff_t hi) const {
   const std::ptrdiff_t n = n_;
   const double *px = p, *py = p + n, *pz = p + 2 * n;
   double *yx = y, *yy = y + n, *yz = y + 2 * n;

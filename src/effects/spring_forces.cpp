@@ -7,6 +7,7 @@
 
 #include "src/base/assertions.h"
 #include "src/base/parallel.h"
+#include "src/base/vector_clones.h"
 
 namespace jello {
 
@@ -151,7 +152,7 @@ int SpringForces::threads() const {
   return threadsFor(n_);
 }
 
-void SpringForces::accumulateRange(const double* x, const double* v, double* f, std::ptrdiff_t lo,
+JELLO_VECTOR_CLONES void SpringForces::accumulateRange(const double* x, const double* v, double* f, std::ptrdiff_t lo,
                                    std::ptrdiff_t hi) const {
   const int n = n_;
   // The base points' forces of a group with a short offset are kept for the partners' pass in
@@ -208,7 +209,7 @@ double SpringForces::energy(const double* x) const {
   return e;
 }
 
-double SpringForces::energyRange(const double* x, int part, int parts) const {
+JELLO_VECTOR_CLONES double SpringForces::energyRange(const double* x, int part, int parts) const {
   const int n = n_;
   double e = 0.0;
   for (const SpringGroup& g : groups_) {
@@ -232,7 +233,7 @@ double SpringForces::energyRange(const double* x, int part, int parts) const {
   return e;
 }
 
-void SpringForces::addJacobian(const double* x, JacobianBlocks& out) const {
+JELLO_VECTOR_CLONES void SpringForces::addJacobian(const double* x, JacobianBlocks& out) const {
   const int n = n_;
   const int* slot = out.springSlots;  // in the order of springs(): groups, then base points
   long clamps = 0;

@@ -40,9 +40,12 @@ def test_measured_thresholds_equal_jello_stability(integrator):
     result = jello.stability_threshold(world, integrator)
     row = committed("free", integrator, 1e4, "measured")
     assert result["outcome"] == row["outcome"] == "threshold"
-    # The same bisection: equal but for the last bits, which differ between CPUs.
-    assert result["stable"] == pytest.approx(float(row["dt_s"]), rel=1e-9)
-    assert result["trials"] == int(row["trials"])
+    # The same bisection to the same 2%. A build for another CPU level than the one that ran
+    # the committed CSV (the default build's clones against -march=native) differs in the last
+    # bits, and where the blow-up rule's decision sits at the threshold they move the bisection
+    # within its resolution: equal to 2% (measured 1.1% apart, 1e-9 on the same build).
+    assert result["stable"] == pytest.approx(float(row["dt_s"]), rel=0.02)
+    assert abs(result["trials"] - int(row["trials"])) <= 2
     assert result["stable"] < result["unstable"] <= 1.02 * result["stable"] * (1 + 1e-12)
 
 
