@@ -152,8 +152,8 @@ int SpringForces::threads() const {
   return threadsFor(n_);
 }
 
-JELLO_VECTOR_CLONES void SpringForces::accumulateRange(const double* x, const double* v, double* f, std::ptrdiff_t lo,
-                                   std::ptrdiff_t hi) const {
+JELLO_VECTOR_CLONES void SpringForces::accumulateRange(const double* x, const double* v, double* f,
+                                                       std::ptrdiff_t lo, std::ptrdiff_t hi) const {
   const int n = n_;
   // The base points' forces of a group with a short offset are kept for the partners' pass in
   // two chunk buffers on the stack (no state in the object, so threads may share it). The
