@@ -7,16 +7,14 @@
 //   one 4-wide vector per point; the substitutions hold eight of a supernode's columns in registers
 //   while they run over its rows, so an entry of L costs one load and one multiply-add for all
 //   three columns; the factor's last supernodes (at 8^3 263 of 512 columns, 61% of L) as one dense
-//   triangle (solvers/linalg/dense_tail.h), read eight entries to a vector. Measured at 8^3 (512
-//   points, 48,000 entries in L, three columns): 20 us (17 us since the blocks' 8 x 8 triangles are
-//   kept inverted: kept_factor.json), against 32 us for the copy without the tail and about 77 us
-//   for CHOLMOD's own solve (the blocks: 3-5% less than the copy by single entries at 8^3, 20% less
-//   at 10^3).
+//   triangle (solvers/linalg/dense_tail.h), read eight entries to a vector. BM_KeptFactorSolve
+//   measures it against CHOLMOD's own solve (experiments/results/kept_factor.json, the table in
+//   solvers/README.md).
 // - above (10^3 points and more: the copy and its indices no longer stay in cache), CHOLMOD's
 //   dense supernodes copied in single precision and solved by our own blocked substitutions
 //   (solvers/linalg/single_supernodes.h),
 //   every product and sum in double: these solves are bound by memory traffic, which the floats
-//   halve (BM_KeptFactorSolve: about a third of CHOLMOD's double solve's time at 16^3 to 32^3). The
+//   halve (BM_KeptFactorSolve/single against /cholmod). The
 //   answer is that of a factor rounded to single precision (about 1e-7 relative times the
 //   condition number): what a preconditioner or projective's fixed-point iterations need, whose
 //   residuals are evaluated in double. singlePrecision = false solves these by CHOLMOD.

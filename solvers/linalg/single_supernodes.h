@@ -4,8 +4,7 @@
 // floats (half the memory traffic of CHOLMOD's doubles: these solves are bound by it) and do
 // every product and sum in double, one to three right-hand sides at once, each block of L read
 // once (and each float widened once) for all of them, eight rows to a vector with AVX-512.
-// Measured (BM_KeptFactorSolve, three columns): about a third of CHOLMOD's double solve at 16^3
-// to 32^3, and slower than PrefactoredCholesky's sparse copy at 8^3.
+// BM_KeptFactorSolve/single against /cholmod and /copy compares them (solvers/README.md).
 #pragma once
 
 #include <vector>

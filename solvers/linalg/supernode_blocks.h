@@ -5,10 +5,8 @@
 // run over the rows: an entry costs one load and one multiply-add, where the copy by single
 // entries cost an index, a gathered value and the entry. The triangle of each eight columns is
 // kept inverted: solving it is then a product whose eight sums do not wait for each other,
-// where substituting through it made every column's value wait for the one before (at 8^3 the
-// chained triangles were 9% of a solve; BM_KeptFactorSolve/copy/8 19.4 -> 16.7 us with the
-// dense tail's backward pass of the same day). At 8^3 the part before the tail is 32
-// supernodes over 249 columns.
+// where substituting through it made every column's value wait for the one before (the chained
+// triangles were latency, not work: BM_KeptFactorSolve/copy).
 #pragma once
 
 #include <vector>

@@ -31,8 +31,7 @@ class SystemOperator final : public LinearOperator {
 
   // y = A p, both 3n component-major; y is overwritten, and must not alias p. Split over
   // threads from kParallelMinPoints points (src/base/parallel.h), as the spring forces are
-  // (round-off apart from the serial sum). Measured at 16^3 on two threads (BM_Threads,
-  // BM_CgSolve): the product 1.43x, a Jacobi-CG solve 1.25x faster.
+  // (round-off apart from the serial sum); BM_Threads/product measures one thread against two.
   void apply(const double* p, double* y) const override;
 
   // Each point's diagonal block of A as 6 arrays of n (xx, xy, xz, yy, yz, zz): block-Jacobi.

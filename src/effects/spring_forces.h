@@ -5,12 +5,11 @@
 // Springs come in groups that share a flat index offset, a rest length and constants: group g
 // links p -> p + delta for p in [first, first + mask.size()) where mask[p - first] != 0. On the
 // lattice every spring offset is one group, so the loop body reads contiguous memory and the
-// compiler vectorizes it, square root and division included. Measured on the AMD EPYC VM
-// (AVX-512 done as two 256-bit halves): the loop is bound by its multiply-adds and its loads
-// and stores together, not by the square root and division (taking them out left a force
-// evaluation as slow); a pass over chunks of 8 base points that kept their positions and
-// forces in registers across the groups, and one with fewer multiply-adds (intrinsics), were
-// both slower than this (8.5-9.3 against 7.3 us at 8^3).
+// compiler vectorizes it, square root and division included. The loop is bound by its
+// multiply-adds and its loads and stores together, not by the square root and division; a pass
+// over chunks of 8 base points that kept their positions and forces in registers across the
+// groups, and one with fewer multiply-adds (intrinsics), were both slower (BM_SpringForces;
+// solvers/README.md keeps what was tried).
 #pragma once
 
 #include <cstddef>
