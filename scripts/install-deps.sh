@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages jello builds, tests and runs with (see README "Dependencies").
+# Installs the Debian 12 packages jello builds, tests and runs with (see src/ARCHITECTURE.md, "Building by hand").
 # Idempotent: packages already present are skipped, and apt is not touched when none is missing.
 set -euo pipefail
 
 packages=(
-  cmake ninja-build g++ pkg-config
+  cmake ninja-build g++ pkg-config ccache
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread libsundials-dev
   freeglut3-dev libgl1-mesa-dev libglu1-mesa-dev xvfb xauth libstb-dev libimgui-dev
   libgtest-dev libgmock-dev libbenchmark-dev

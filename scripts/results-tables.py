@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""The README's Results numbers from the committed CSV alone (no number typed by hand).
+"""The documents' results from the committed CSV and JSON alone (no number typed by hand):
+the README's findings and CI time, and the experiments' summaries (experiments/README.md).
 
 Rewrites the blocks between <!-- stability-summary:begin/end --> (the stability map's measured
 thresholds against their predictions, per integrator and scene, from
@@ -9,9 +10,9 @@ from experiments/results/work_precision.csv and its sidecar), <!-- implicit-damp
 <!-- scaling-summary:... --> (cost per simulated second against N, from scaling.csv) and
 <!-- drift-summary:... --> (the long-run drift of energy and angular momentum per integrator,
 from work_precision_drift_summary.csv), the crossover atlas's (atlas-summary and atlas-region
-from every *_atlas.csv; atlas-free-summary from experiments/results/atlas_free/) in README.md.
-With --check it changes
-nothing and exits 1 when README.md differs from what the data gives (ctest runs it so).
+from every *_atlas.csv; atlas-free-summary from experiments/results/atlas_free/), each in the
+document scripts/readme_blocks.py names. With --check it changes nothing and exits 1 when a
+document differs from what the data gives (ctest runs it so).
 
     scripts/results-tables.py [--check]
 """
@@ -24,7 +25,8 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import closed_sets  # noqa: E402
-from readme_blocks import replace_block  # noqa: E402
+import readme_blocks  # noqa: E402
+from readme_blocks import replace_block, write_blocks  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 RESULTS = os.path.join(ROOT, "experiments", "results")
@@ -348,6 +350,21 @@ def atlas_cheapest(rows, explicit=None):
     return min(ok, key=lambda r: float(r["wall_per_simulated_s"]), default=None)
 
 
+def atlas_pays(subdirectory=""):
+    """(N, k, integrator, speed-up) wherever an implicit or adaptive method keeps the visible
+    motion for less than the cheapest explicit one, in order of N and k."""
+    pays = []
+    for n, (rows, _) in sorted(atlas_sources(subdirectory).items()):
+        for k in sorted({float(r["k_N_per_m"]) for r in rows}):
+            here = [r for r in rows if float(r["k_N_per_m"]) == k]
+            e, o = atlas_cheapest(here, True), atlas_cheapest(here, False)
+            if e and o:
+                x = float(e["wall_per_simulated_s"]) / float(o["wall_per_simulated_s"])
+                if x >= 1:
+                    pays.append((n, k, o["integrator"], x))
+    return pays
+
+
 def atlas_summary(subdirectory=""):
     by_n = atlas_sources(subdirectory)
     first = next(iter(by_n.values()))[1][0]["parameters"]["atlas"]
@@ -355,7 +372,6 @@ def atlas_summary(subdirectory=""):
     lines = [f"Visible motion within {100 * first['tolerance_m']:g} cm at the corners over "
              f"{first['time_s']:g} s; the references within {1e3 * min(checks):.2g}-"
              f"{1e3 * max(checks):.2g} mm of RK4 at twice their step.", ""]
-    pays = []
     for n in sorted(by_n):
         rows, sidecars = by_n[n]
         budgets = sorted({s["parameters"]["atlas"]["run_budget_s"] for s in sidecars})
@@ -383,14 +399,13 @@ def atlas_summary(subdirectory=""):
             if e and o:
                 x = float(e["wall_per_simulated_s"]) / float(o["wall_per_simulated_s"])
                 ratio = f"{x:.2g}x faster" if x >= 1 else f"{1 / x:.2g}x slower"
-                if x >= 1:
-                    pays.append((n, k, o["integrator"], x))
             missing = ", ".join(sorted(r["integrator"] + ("" if r["outcome"] == "not_reached"
                                                           else f" ({r['outcome']})")
                                        for r in here if r["outcome"] != "ok"))
             lines.append(f"| {k_text(k)} | {float(here[0]['w_max_rad_per_s']):,.0f} | {text(e)} | "
                          f"{text(o)} | {ratio} | {missing} |")
         lines.append("")
+    pays = atlas_pays(subdirectory)
     if pays:
         lines.append("Where an implicit or adaptive method is cheapest: " + "; ".join(
             f"N = {n}, k = {k_text(k)}: {name}, {x:.2g}x faster than the cheapest explicit method"
@@ -474,7 +489,148 @@ def experiments_runtime():
     return text
 
 
-BLOCKS = {"stability-summary": stability_summary,
+def cheapest_by_accuracy(scene_name):
+    """{accuracy (m): (wall time (s), label)} of the cheapest run keeping the position error
+    within it, on one work-precision scene (accuracies the reference resolves)."""
+    rows = [r for r in read_rows("work_precision") if r["outcome"] == "ok"]
+    scene = next(s for s in read_sidecar("work_precision")["parameters"]["scenes"]
+                 if s["scene"] == scene_name)
+    best = {}
+    for label in precision_labels(rows):
+        integ, _, method = label.partition(" ")
+        runs = [r for r in rows if r["scene"] == scene_name and r["integrator"] == integ
+                and r["cvode_method"] == (method or "none")]
+        for a in ACCURACIES:
+            ok = [float(r["wall_time_s"]) for r in runs if float(r["position_error_max_m"]) <= a]
+            if ok and a >= 10 * scene["reference_vs_twice_its_step_m"]:
+                best[a] = min(best.get(a, (float("inf"), "")), (min(ok), label))
+    return best
+
+
+def crossover_ms():
+    """{(method, exponent of k): wall ms per simulated second} of BM_Crossover's medians."""
+    with open(os.path.join(RESULTS, "crossover.json")) as f:
+        data = json.load(f)
+    unit = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}
+    return {tuple(b["name"].split("/")[1:3]): b["real_time"] * unit[b["time_unit"]]
+            for b in data["benchmarks"]
+            if b.get("aggregate_name") == "median" and b["name"].startswith("BM_Crossover/")}
+
+
+def findings():
+    """The README's findings, five sentences, every figure from the committed results."""
+    rows = [r for r in read_rows("stability") if r["scene"] == "free"]
+    by = {}
+    for r in rows:
+        by.setdefault(r["integrator"], {}).setdefault(float(r["k_N_per_m"]), {})[r["source"]] = r
+    limits = []
+    for name in ORDER:
+        points = by.get(name, {})
+        if not INTEGRATORS[name]["explicit"] or not points:
+            continue
+        ratio = {k: float(p["measured"]["dt_s"]) / float(p["predicted"]["dt_s"])
+                 for k, p in points.items() if float(p["predicted"]["dt_s"]) > 0}
+        if max(ratio.values()) <= 1.1:
+            limits.append(f"{name} at {span(list(ratio.values()))} of its predicted step")
+        else:  # within 10% only from some k on: there the prediction holds
+            ks = sorted(ratio)
+            start = next(k for i, k in enumerate(ks) if all(ratio[q] <= 1.1 for q in ks[i:]))
+            limits.append(f"{name} at its damping limit h = c/k from k = {k_text(start)} up "
+                          "(below, its slow growth outlasts the run)")
+    stable = [n for n in ORDER if not INTEGRATORS[n]["explicit"] and by.get(n) and
+              all(p["measured"]["outcome"] == "stable_to_max" for p in by[n].values())]
+    unstable = [n for n in ORDER if not INTEGRATORS[n]["explicit"] and by.get(n) and n not in stable]
+    dt_max = max(float(p["measured"]["dt_s"]) for n in stable for p in by[n].values())
+    blew = "; ".join(
+        f"{n} blew up past h w_max {span([float(p['measured']['courant_number']) for p in by[n].values() if p['measured']['outcome'] != 'stable_to_max'])}"
+        for n in unstable)
+    ks = sorted({float(r["k_N_per_m"]) for r in rows})
+    first = (f"**Where each integrator blows up**: the explicit ones where linear stability "
+             f"predicts ({'; '.join(limits)}; the free cube, k = {k_text(ks[0])} to "
+             f"{k_text(ks[-1])} N/m); every other method survived every step tried up to "
+             f"dt = {dt_max:g} s"
+             + (f", except that {blew} on the free cube, whose corner is pulled a whole "
+                "spacing: a nonlinear instability the linear prediction cannot see"
+                if unstable else "") + ".")
+    soft = cheapest_by_accuracy("soft")
+    coarse, fine = soft[1e-2], soft[1e-3]
+    rk4 = {a: t for a, (t, lab) in soft.items() if lab == "rk4"}
+    damping = implicit_damping_loss()
+    wp = [r for r in read_rows("work_precision") if r["outcome"] == "ok" and r["scene"] == "soft"]
+    first_order = [n for n in closed_sets.study_order()
+                   if INTEGRATORS[n]["linear_model"] == "BackwardEuler"]
+    closest = min(float(r["position_error_max_m"]) for r in wp if r["integrator"] in first_order)
+    second = (f"**What accuracy costs**: through jello.w's first contact the cheapest way to "
+              f"1 cm is {coarse[1]} ({seconds(coarse[0])} of wall time), to 1 mm {fine[1]} "
+              f"({seconds(fine[0])}); the first-order implicit methods come no closer than "
+              f"{closest:.2g} m at any step tried, their artificial damping's price (backward "
+              f"Euler removes {damping[1]:.4g}% of an undamped stiff cube's vibration energy in "
+              f"{damping[2]:g} s even at h w_max = {damping[0]:.2g}).")
+    free = atlas_pays(ATLAS_FREE)
+    falling = atlas_pays()
+    free8 = [p for p in free if p[0] == min(q[0] for q in free)]
+    third = (f"**Where implicit integration pays**: in free flight from k = {k_text(free8[0][1])} "
+             f"at N = {free8[0][0]} ({free8[0][2]}, {free8[0][3]:.2g}x faster than the cheapest "
+             f"explicit method; {free8[-1][3]:.2g}x at k = {k_text(free8[-1][1])}); once the cube "
+             "falls onto the course's soft floor (400 N/m), " +
+             ("only at " + "; ".join(f"N = {n}, k = {k_text(k)} ({name}, {x:.2g}x)"
+                                    for n, k, name, x in falling) if falling else "nowhere") +
+             " in the crossover atlas (N = 8, 16, 32; k = 10^2 to 10^8).")
+    cross = crossover_ms()
+    pd = closed_sets.names("Projective")[0]  # the crossover benchmark's subject
+    fourth = (f"**How fast**: projective dynamics takes a simulated second of the spinning cube "
+              f"at k = 10^5 in {cross[(pd, '5')]:.3g} ms against RK4's "
+              f"{cross[('rk4', '5')]:.3g} ms at its stability limit "
+              f"({cross[('rk4', '5')] / cross[(pd, '5')]:.2g}x, one core, the native build); no "
+              "comparison with other libraries is committed here.")
+    return "\n\n".join([first, second, third, fourth])
+
+
+def implicit_damping_loss():
+    """(h w_max, % lost, window) of backward Euler at its smallest step in the damping study."""
+    rows = sorted((r for r in read_rows("work_precision_damping") if r["integrator"] == "implicit"),
+                  key=lambda r: float(r["dt_s"]))
+    span_s = read_sidecar("work_precision")["parameters"]["damping_scene"]["time_s"]
+    r = rows[0]
+    return (float(r["h_w_max"]), 100 * (1 - float(r["energy_end_J"]) / float(r["energy_start_J"])),
+            span_s)
+
+
+def ci_time():
+    """How long CI took from a fresh clone (scripts/time-ci.sh writes ci_time.json)."""
+    path = os.path.join(RESULTS, "ci_time.json")
+    if not os.path.exists(path):
+        return "CI's time from a fresh clone is not measured yet (`scripts/time-ci.sh`)."
+    with open(path) as f:
+        t = json.load(f)
+    return (f"CI (`.ci/run`: format, layers and function-length checks, the release suite with "
+            f"warnings as errors, 60 s of fuzzing, the sanitized suite) took "
+            f"{t['wall_time_s'] / 60:.1f} minutes from a fresh clone on {t['machine']} "
+            f"({t['date_utc'][:10]}, commit {t['commit'][:7]}, ccache {t['ccache']}).")
+
+
+FAMILY_WORDS = {"Explicit": "explicit", "Newton": "implicit, Newton to convergence",
+                "Linearized": "implicit, one linear solve a step", "Cvode": "adaptive (SUNDIALS)",
+                "Projective": "implicit, prefactored local/global iterations"}
+MODEL_WORDS = {"ForwardEuler": "stable only for h <= c/k", "SymplecticEuler": "h w_max < 2",
+               "RungeKutta4": "h w_max <= 2 sqrt 2", "BackwardEuler": "A-stable, damps",
+               "Bdf2": "A-stable, damps high modes", "Trapezoidal": "A-stable, no damping",
+               "Adaptive": "error-controlled"}
+
+
+def integrator_list():
+    """The README's table of integrators, from the integrator table itself."""
+    lines = ["| integrator | kind | on a linear mode | what it is |", "|---|---|---|---|"]
+    for r in closed_sets.integrators():
+        lines.append(f"| `{r['name']}` | {FAMILY_WORDS[r['family']]} | "
+                     f"{MODEL_WORDS[r['linear_model']]} | {r['summary']} |")
+    return "\n".join(lines)
+
+
+BLOCKS = {"findings": findings,
+          "integrator-list": integrator_list,
+          "ci-time": ci_time,
+          "stability-summary": stability_summary,
           "scaling-summary": scaling_summary,
           "work-precision-summary": work_precision_summary,
           "implicit-damping": implicit_damping,
@@ -485,35 +641,27 @@ BLOCKS = {"stability-summary": stability_summary,
           "experiments-runtime": experiments_runtime}
 
 
-def render(text):
-    for name, make in BLOCKS.items():
-        text = replace_block(text, name, make())
-    return text
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--check", action="store_true",
-                        help="change nothing; exit 1 if README.md disagrees with the data")
+                        help="change nothing; exit 1 if a document disagrees with the data")
     args = parser.parse_args()
-    with open(README) as f:
-        text = f.read()
-    new = render(text)
+    blocks = {name: make() for name, make in BLOCKS.items()}
     if args.check:
-        if new != text:
-            print("results-tables: README.md disagrees with experiments/results (run "
-                  "scripts/results-tables.py)", file=sys.stderr)
-            return 1
-        print("results-tables: README.md agrees with the data")
-        return 0
-    if new != text:
-        with open(README + ".tmp", "w") as f:
-            f.write(new)
-        os.replace(README + ".tmp", README)
-    for make in BLOCKS.values():
-        print(make())
-    return 0
+        stale = []
+        for name, body in blocks.items():
+            with open(readme_blocks.document(name)) as f:
+                text = f.read()
+            if replace_block(text, name, body, readme_blocks.document(name)) != text:
+                stale.append(f"{readme_blocks.BLOCKS[name]} ({name})")
+        if stale:
+            print("results-tables: these blocks disagree with experiments/results (run "
+                  "scripts/results-tables.py): " + ", ".join(stale))
+            sys.exit(1)
+        print("results-tables: every document agrees with the data")
+    else:
+        write_blocks(blocks)
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

@@ -180,7 +180,7 @@ def context_line(r):
     c = r.context
     return (f"Measured {c['date'][:10]} with `scripts/speed-tables.py --run` (one core, "
             f"medians of 3 repetitions, {c.get('host_name', '?')}, {c['num_cpus']} CPUs at "
-            f"{c['mhz_per_cpu']} MHz, the Release build: `-O3 -march=native`; "
+            f"{c['mhz_per_cpu']} MHz, the native build: `-O3 -march=native`; "
             "`experiments/results/speed.json`). The machine is a shared VM: compare figures "
             "within one run, not across runs.")
 

@@ -1,4 +1,4 @@
-// Settings of the implicit integrators, as plain structs (README "Implicit solvers").
+// Settings of the implicit integrators, as plain structs (solvers/README.md).
 #pragma once
 
 #include "solvers/linalg/linear_solver.h"
@@ -28,7 +28,7 @@ struct ImplicitOptions {
   int seedIterations = 0;
   // The seeds stop at this relative residual, from where Newton converges in one or two
   // iterations; at or below newtonTolerance they may converge the step themselves (with
-  // Chebyshev acceleration, cheaper than Newton's iterations: README "Implicit solvers").
+  // Chebyshev acceleration, cheaper than Newton's iterations: solvers/README.md).
   double seedTolerance = 1e-4;
   // Chebyshev acceleration of the seeds (Wang 2015; ProjectiveOptions::chebyshevRho): 0 off.
   double seedChebyshevRho = 0.0;

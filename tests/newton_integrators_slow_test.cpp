@@ -137,7 +137,7 @@ TEST(NewtonIntegrators, AReassignedModelAtTheSameAddressIsBoundAfresh) {
 // equations may have no root, and Newton was seen cycling between iterates on either side
 // (relative residual 0.84 and 0.016 for 30 iterations, 200 did not help). Without the
 // contact's damping the same steps converge: the steps left unconverged are the model's jump,
-// not the solver's failing (README, "implicit").
+// not the solver's failing (solvers/README.md, "implicit").
 long unconvergedStepsOfJelloAt16(double contactDamping) {
   World w = resampleCube(test::loadWorld("jello.w"), 16);
   w.dCollision = contactDamping;

@@ -217,7 +217,7 @@ TEST(NewtonIntegrators, ReusingTheFactorGivesTheSameConvergedSteps) {
 }
 
 // Seeds with Chebyshev acceleration down to Newton's tolerance: the fastest configuration
-// (README "Implicit solvers").
+// (solvers/README.md).
 ImplicitOptions chebyshevSeeded() {
   ImplicitOptions o;
   o.linearSolver = LinearSolverKind::Cg;

@@ -21,8 +21,8 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 JSON = os.path.join(ROOT, "experiments", "results", "python_step_overhead.json")
-README = os.path.join(ROOT, "README.md")
-BEGIN, END = "<!-- python-overhead:begin -->", "<!-- python-overhead:end -->"
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from readme_blocks import write_blocks  # noqa: E402  (the block lives in python/README.md)
 
 
 def measure(sim, steps, repetitions):
@@ -114,16 +114,7 @@ def main():
         data = json.load(f)
     print(table(data))
     if args.readme:
-        with open(README) as f:
-            text = f.read()
-        if BEGIN not in text or END not in text:
-            sys.exit(f"README.md has no {BEGIN} ... {END} markers")
-        head, rest = text.split(BEGIN, 1)
-        _, tail = rest.split(END, 1)
-        tmp = README + ".tmp"
-        with open(tmp, "w") as f:
-            f.write(head + BEGIN + "\n" + table(data) + "\n" + END + tail)
-        os.replace(tmp, README)
+        write_blocks({"python-overhead": table(data)})
     return 0
 
 

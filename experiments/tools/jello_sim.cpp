@@ -96,13 +96,14 @@ void warnOfLightlyDampedStiffness(const Simulation& sim, double simulated, doubl
                                   double dElastic) {
   const auto w = jello::cvodeCostWarning(sim.model(), sim.state(), simulated, kElastic, dElastic);
   if (!w) return;
-  std::fprintf(stderr,
-               "jello-sim: warning: cvode follows this scene's fastest mode (w_max = %.3g rad/s, "
-               "damping ratio %.2g) at its tolerance: if the start excites it, expect about %.2g "
-               "internal steps for %g simulated s (h w_max ~ %g, measured). implicit or "
-               "projective at --dt 0.001 step over it, at the price of damping it (README, "
-               "\"cvode on very stiff scenes\")\n",
-               w->wMax, w->dampingRatio, w->steps, simulated, jello::kCvodeStepTimesWmax);
+  std::fprintf(
+      stderr,
+      "jello-sim: warning: cvode follows this scene's fastest mode (w_max = %.3g rad/s, "
+      "damping ratio %.2g) at its tolerance: if the start excites it, expect about %.2g "
+      "internal steps for %g simulated s (h w_max ~ %g, measured). implicit or "
+      "projective at --dt 0.001 step over it, at the price of damping it (solvers/README.md, "
+      "\"cvode on very stiff scenes\")\n",
+      w->wMax, w->dampingRatio, w->steps, simulated, jello::kCvodeStepTimesWmax);
 }
 
 // What a run came to: the steps done, its wall time, and why it stopped early if it did.
@@ -217,7 +218,7 @@ nlohmann::json statistics(const Options& opt, const Simulation& sim, const Outco
                    "jello-sim: warning: %.0f of %ld steps did not converge within %d Newton "
                    "iterations (raise --newton-iters or --newton-tol; but where a point meets a "
                    "wall or an obstacle at speed the contact's damping force jumps and the "
-                   "step's equations may have no root: README, \"implicit\")\n",
+                   "step's equations may have no root: solvers/README.md, \"implicit\")\n",
                    st.value, o.done, opt.solver.implicit.newtonMaxIterations);
     }
   }

@@ -1,7 +1,7 @@
-// Both cores for the model's large loops (README "Speed"): a small pool of worker threads that
-// runs the parts of one loop at once. The model's forces (with an explicit step's updates fused
-// in, Model::acceleration), the springs' energy, the simulation's per-step checks and the
-// implicit solvers' matrix-free product use it, the model only from kParallelMinPoints points
+// Both cores for the model's large loops (experiments/bench/README.md): a small pool of worker
+// threads that runs the parts of one loop at once. The model's forces (with an explicit step's
+// updates fused in, Model::acceleration), the springs' energy, the simulation's per-step checks and
+// the implicit solvers' matrix-free product use it, the model only from kParallelMinPoints points
 // up, where a loop is long enough (milliseconds) to pay for waking a thread and for the
 // worker's spinning beside the step's serial rest. The pool is shared by the
 // process: a caller that finds it busy (another thread's loop, an experiment's parallel grid)

@@ -10,7 +10,8 @@
 #pragma once
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && \
-    !defined(JELLO_NATIVE_BUILD) && !defined(__SANITIZE_ADDRESS__)
+    !defined(JELLO_NATIVE_BUILD) && !defined(__SANITIZE_ADDRESS__) &&  \
+    !defined(__SANITIZE_THREAD__)
 #define JELLO_VECTOR_CLONES \
   __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"), flatten))
 #else

@@ -1,4 +1,4 @@
-// Reads a world file (README "World files"): the original course format, then an optional
+// Reads a world file (worlds/README.md): the original course format, then an optional
 // extension block after the velocities. Every error names file, line and token; nothing
 // half-read is ever returned.
 #pragma once

@@ -1,7 +1,8 @@
-"""Every generated table in README.md equals what its script makes of the committed data
-(experiments/results: CSV and benchmark JSON): a README edited by hand, or data regenerated
-without rewriting the README, fails here. Each script's own table function is called on the
-committed files; nothing is measured."""
+"""Every generated block of the documents (README.md and the documents beside what they
+describe, scripts/readme_blocks.py's map) equals what its script makes of the committed data
+(experiments/results: CSV and benchmark JSON): a document edited by hand, or data regenerated
+without rewriting it, fails here. Each script's own function is called on the committed files;
+nothing is measured."""
 import importlib.util
 import json
 import os
@@ -11,7 +12,6 @@ import re
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-README = (ROOT / "README.md").read_text()
 
 
 def load(relative):
@@ -22,10 +22,16 @@ def load(relative):
     return module
 
 
+blocks_map = None
+
+
 def block(name):
+    global blocks_map
+    blocks_map = blocks_map or load("scripts/readme_blocks.py")
+    text = (ROOT / blocks_map.BLOCKS[name]).read_text()
     match = re.search(rf"<!-- {re.escape(name)}:begin -->\n(.*?)\n<!-- {re.escape(name)}:end -->",
-                      README, re.S)
-    assert match, f"README.md has no {name} block"
+                      text, re.S)
+    assert match, f"{blocks_map.BLOCKS[name]} has no {name} block"
     return match.group(1)
 
 
@@ -56,19 +62,11 @@ def other_tables():
     overhead = load("experiments/python/bench_step_overhead.py")
     with open(overhead.JSON) as f:
         data = json.load(f)
+    results = load("scripts/results-tables.py")
     return {"cvode-stiff": stiff.table(stiff.committed_rows()),
             "viewer-speed": load("scripts/viewer-table.py").table(),
             "python-overhead": overhead.table(data),
-            "stability-summary": load("scripts/results-tables.py").stability_summary(),
-            "work-precision-summary":
-                load("scripts/results-tables.py").work_precision_summary(),
-            "implicit-damping": load("scripts/results-tables.py").implicit_damping(),
-            "scaling-summary": load("scripts/results-tables.py").scaling_summary(),
-            "drift-summary": load("scripts/results-tables.py").drift_summary(),
-            "atlas-summary": load("scripts/results-tables.py").atlas_summary(),
-            "atlas-region": load("scripts/results-tables.py").atlas_region(),
-            "atlas-free-summary": load("scripts/results-tables.py").atlas_summary("atlas_free"),
-            "experiments-runtime": load("scripts/results-tables.py").experiments_runtime()}
+            **{name: make() for name, make in results.BLOCKS.items()}}
 
 
 @pytest.mark.parametrize("tables", [speed_tables, integrator_tables, other_tables])
@@ -77,7 +75,15 @@ def test_readme_tables_equal_their_data(tables):
         assert block(name) == text, f"README block {name} disagrees with its data: rerun its script"
 
 
-def test_every_block_in_the_readme_is_checked():
-    names = set(re.findall(r"<!-- ([a-z0-9-]+):begin -->", README))
+def test_every_block_of_every_document_is_checked():
+    blocks = load("scripts/readme_blocks.py")
     checked = set(speed_tables()) | set(integrator_tables()) | set(other_tables())
-    assert names == checked
+    assert set(blocks.BLOCKS) == checked
+    # And every block marker in the project's documents is one of them, in its own document.
+    found = {}
+    for path in ROOT.glob("**/*.md"):
+        if "build" in path.relative_to(ROOT).parts:
+            continue
+        for name in re.findall(r"<!-- ([a-z0-9-]+):begin -->", path.read_text()):
+            found[name] = str(path.relative_to(ROOT))
+    assert found == blocks.BLOCKS

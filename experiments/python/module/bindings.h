@@ -1,4 +1,4 @@
-// What the parts of the Python module share (jello._core, README "From Python"): the
+// What the parts of the Python module share (jello._core, experiments/python/README.md): the
 // conversions between Python values and the simulator's, the exceptions it raises, the solver
 // options as keywords, and the functions that bind each part.
 //   convert.cpp     conversions, exceptions, solver options from keywords

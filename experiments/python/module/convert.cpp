@@ -137,7 +137,7 @@ void translateExceptions(std::exception_ptr p) {
 
 // ---- solver options from keywords -----------------------------------------------------------
 
-// The keywords mirror jello-sim's flags with '_' for '-' (README "From Python").
+// The keywords mirror jello-sim's flags with '_' for '-' (experiments/python/README.md).
 constexpr const char* kSolverOptionNames =
     "linear_solver, preconditioner, matrix_free, clamp, cg_tol, newton_iters, newton_tol, "
     "newton_xtol, factor_reuse, newton_seed, newton_seed_tol, newton_seed_chebyshev, "

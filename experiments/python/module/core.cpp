@@ -1,5 +1,5 @@
 // jello._core: the simulator as a Python module (pybind11). jello/__init__.py re-exports it and
-// defines the exception classes it raises (WorldError, Diverged). README "From Python"; the
+// defines the exception classes it raises (WorldError, Diverged). experiments/python/README.md; the
 // parts are listed in bindings.h.
 //
 // Conventions: positions, velocities and forces cross as (n, 3) float64 arrays; the state's

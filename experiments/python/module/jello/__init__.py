@@ -1,4 +1,4 @@
-"""jello: the elastic jello cube simulator, from Python (README "From Python").
+"""jello: the elastic jello cube simulator, from Python (experiments/python/README.md).
 
     import jello
     world = jello.load_world("worlds/jello.w")
