@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# Configures (once, or again when JELLO_WERROR is set) and builds one CMake preset: release
+# Configures (once, or again when JELLO_WERROR asks for another value) and builds one CMake preset: release
 # (default: runs on any x86-64), native (-march=native: benchmarks), debug, asan or fuzz.
 # Programs land in build/<preset>/bin.
 # JELLO_WERROR=ON (as CI sets it) turns compiler warnings into errors.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset=${1:-release}
-if [ ! -f "build/$preset/CMakeCache.txt" ] || [ -n "${JELLO_WERROR:-}" ]; then
+cache=build/$preset/CMakeCache.txt
+if [ ! -f "$cache" ] ||
+  { [ -n "${JELLO_WERROR:-}" ] && ! grep -qx "JELLO_WERROR:BOOL=$JELLO_WERROR" "$cache"; }; then
   cmake --preset "$preset" ${JELLO_WERROR:+"-DJELLO_WERROR=$JELLO_WERROR"} >/dev/null
 fi
 cmake --build --preset "$preset" -j"$(env -u OMP_NUM_THREADS -u OMP_THREAD_LIMIT nproc)"

@@ -603,10 +603,13 @@ def ci_time():
         return "CI's time from a fresh clone is not measured yet (`scripts/time-ci.sh`)."
     with open(path) as f:
         t = json.load(f)
+    stages = ", ".join(f"{name} {seconds / 60:.1f}" for name, seconds in t["stages_s"].items()
+                       if seconds >= 30)
     return (f"CI (`.ci/run`: format, layers and function-length checks, the release suite with "
             f"warnings as errors, 60 s of fuzzing, the sanitized suite) took "
             f"{t['wall_time_s'] / 60:.1f} minutes from a fresh clone on {t['machine']} "
-            f"({t['date_utc'][:10]}, commit {t['commit'][:7]}, ccache {t['ccache']}).")
+            f"({t['date_utc'][:10]}, commit {t['commit'][:7]}, ccache {t['ccache']}); "
+            f"the stages over half a minute: {stages} minutes.")
 
 
 FAMILY_WORDS = {"Explicit": "explicit", "Newton": "implicit, Newton to convergence",
