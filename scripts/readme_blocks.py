@@ -14,6 +14,7 @@ BLOCKS = {
     "findings": "README.md",
     "integrator-list": "README.md",
     "ci-time": "README.md",
+    "contact-newton": "README.md",
     "experiments-runtime": "experiments/README.md",
     "stability-summary": "experiments/README.md",
     "work-precision-summary": "experiments/README.md",

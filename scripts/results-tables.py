@@ -612,6 +612,33 @@ def ci_time():
             f"the stages over half a minute: {stages} minutes.")
 
 
+def contact_newton():
+    """Newton's unconverged steps per scene, integrator and contact model (scripts/contact-table.py)."""
+    path = os.path.join(RESULTS, "contact_models.json")
+    if not os.path.exists(path):
+        return "Not measured yet (`scripts/contact-table.py`)."
+    with open(path) as f:
+        data = json.load(f)
+    runs = data["runs"]
+    models = list(dict.fromkeys(r["contact"] for r in runs))
+    head = "| scene | integrator | " + " | ".join(
+        f"{m}: unconverged, Newton/step" for m in models) + " |"
+    lines = [head, "|---|---|" + "---|" * len(models)]
+    cells = {}
+    for r in runs:
+        cells.setdefault((r["scene"], r["integrator"]), {})[r["contact"]] = r
+    for (scene, integrator), by_model in cells.items():
+        row = [f"{r['unconverged_steps']} of {r['steps']}, {r['newton_per_step']:.1f}"
+               + (" (diverged)" if r["diverged"] else "")
+               for r in (by_model[m] for m in models)]
+        lines.append(f"| {scene} | `{integrator}` | " + " | ".join(row) + " |")
+    layer = next(r["contact_layer_m"] for r in runs if r["contact"] == "smooth")
+    lines.append("")
+    lines.append(f"The smooth model at its default layer, {layer * 1000:g} mm "
+                 f"({data['date_utc'][:10]}, commit {data['commit'][:7]}).")
+    return "\n".join(lines)
+
+
 FAMILY_WORDS = {"Explicit": "explicit", "Newton": "implicit, Newton to convergence",
                 "Linearized": "implicit, one linear solve a step", "Cvode": "adaptive (SUNDIALS)",
                 "Projective": "implicit, prefactored local/global iterations"}
@@ -633,6 +660,7 @@ def integrator_list():
 BLOCKS = {"findings": findings,
           "integrator-list": integrator_list,
           "ci-time": ci_time,
+          "contact-newton": contact_newton,
           "stability-summary": stability_summary,
           "scaling-summary": scaling_summary,
           "work-precision-summary": work_precision_summary,

@@ -13,7 +13,7 @@ ModelSpec modelSpecFromWorld(const World& world) {
   spec.numPoints = lattice.numPoints();
   spec.mass = world.mass;
   spec.springs = latticeSpringGroups(lattice, world.kElastic, world.dElastic);
-  spec.contact = {world.kCollision, world.dCollision};
+  spec.contact = {world.kCollision, world.dCollision, world.contact.model, world.contact.layer};
   spec.plane = world.plane;
   spec.sphere = world.sphere;
   spec.cone = world.cone;

@@ -439,6 +439,45 @@ TEST(JelloCreateWorld, RefusesBadValuesAndWritesNothing) {
   EXPECT_NE(run(create() + " -o /nonexistent/dir/w.w").code, 0);
 }
 
+// --contact and --contact-layer: written into the world by jello-create-world, overriding the
+// file's in jello-sim (its stats say which ran), refused with exit 2 when wrong.
+TEST(Contact, FlagsChooseTheModelInBothToolsAndBadOnesAreRefused) {
+  test::TempDir dir;
+  const auto out = dir.path() / "w.w";
+  ASSERT_EQ(run(create() + " -o " + out.string() + " --contact smooth").code, 0);
+  EXPECT_EQ(readWorld(out).contact, (ContactLaw{ContactModel::Smooth, kDefaultContactLayer}));
+  ASSERT_EQ(run(create() + " -o " + out.string() + " --contact SMOOTH --contact-layer 0.002").code,
+            0);
+  EXPECT_EQ(readWorld(out).contact, (ContactLaw{ContactModel::Smooth, 0.002}));
+  const auto bad = dir.path() / "bad.w";
+  EXPECT_EQ(run(create() + " -o " + bad.string() + " --contact sticky").code, 2);
+  EXPECT_EQ(run(create() + " -o " + bad.string() + " --contact-layer 0.01").code, 2);
+  EXPECT_EQ(run(create() + " -o " + bad.string() + " --contact smooth --contact-layer 0").code, 2);
+  EXPECT_FALSE(std::filesystem::exists(bad));
+
+  const auto stats = dir.path() / "s.json";
+  const auto modelRun = [&](const std::string& file, const std::string& flags) {
+    const Outcome r =
+        run(sim() + " " + file + " --steps 20 --quiet --stats " + stats.string() + " " + flags);
+    EXPECT_EQ(r.code, 0) << r.output;
+    std::ifstream in(stats);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    return std::make_pair(j["contact"]["model"].get<std::string>(),
+                          j["contact"]["layer_m"].get<double>());
+  };
+  EXPECT_EQ(modelRun(out.string(), ""), std::make_pair(std::string("smooth"), 0.002));
+  EXPECT_EQ(modelRun(out.string(), "--contact penalty"),
+            std::make_pair(std::string("penalty"), 0.0));
+  EXPECT_EQ(modelRun(out.string(), "--contact-layer 0.003"),
+            std::make_pair(std::string("smooth"), 0.003));
+  EXPECT_EQ(modelRun(world("jello.w"), "--contact smooth"),
+            std::make_pair(std::string("smooth"), kDefaultContactLayer));
+  const Outcome wrong = run(sim() + " " + world("jello.w") + " --steps 1 --contact-layer 0.01");
+  EXPECT_EQ(wrong.code, 2);
+  EXPECT_TRUE(contains(wrong.output, "applies to the smooth contact model only")) << wrong.output;
+  EXPECT_EQ(run(sim() + " " + world("jello.w") + " --steps 1 --contact bogus").code, 2);
+}
+
 // #16: --stats /dev/stdout works (the link is followed to the pipe and written in place), and
 // --out to a device leaves the device a device. Private stand-ins, never the machine's own
 // /dev/stdout or /dev/null: a writer that regressed would replace them.

@@ -154,6 +154,8 @@ void Panel::syncFromWorld(const Frame& frame) {
   d_ = static_cast<float>(w.dElastic);
   kCollision_ = static_cast<float>(w.kCollision);
   dCollision_ = static_cast<float>(w.dCollision);
+  contact_ = w.contact;
+  if (w.contact.layer > 0.0) contactLayer_ = static_cast<float>(w.contact.layer);
   mass_ = static_cast<float>(w.mass);
   dt_ = static_cast<float>(frame.dt);
   if (w.plane) savedPlane_ = w.plane;
@@ -178,6 +180,14 @@ void Panel::constants(const Frame& frame, SimRunner& runner) {
   }
   if (logSlider("d contact", &dCollision_, 1e-4f, 100.0f, "%.3g")) {
     edit([d = double(dCollision_)](World& w) { w.dCollision = d; });
+  }
+  bool contactChanged = tableCombo("contact", contact_.model, allContactModels(), contactModelName);
+  if (contact_.model == ContactModel::Smooth) {
+    contactChanged |= logSlider("layer (m)", &contactLayer_, 1e-4f, 0.1f, "%.3g");
+  }
+  if (contactChanged) {
+    contact_.layer = contact_.model == ContactModel::Smooth ? double(contactLayer_) : 0.0;
+    edit([law = contact_](World& w) { w.contact = law; });
   }
   if (logSlider("mass (kg)", &mass_, 1e-5f, 1.0f, "%.3g")) {
     edit([m = double(mass_)](World& w) { w.mass = m; });

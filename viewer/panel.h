@@ -69,6 +69,8 @@ class Panel {
   long generation_ = -1;
   // Slider values, taken from the world when the scene is replaced.
   float k_ = 0, d_ = 0, kCollision_ = 0, dCollision_ = 0, mass_ = 0, fieldScale_ = 1;
+  ContactLaw contact_;
+  float contactLayer_ = float(kDefaultContactLayer);
   float dt_ = 0;
   float pullScale_ = 1;
   SolverOptions options_;  // the solver section's copy while editing

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "experiments/common/signal_handler.h"
+#include "experiments/tools/contact_flags.h"
 #include "src/base/atomic_file.h"
 #include "src/base/finite_options.h"
 #include "src/base/out_of_memory.h"
@@ -44,6 +45,7 @@ struct Flags {
   std::vector<double> plane, sphere, cone, spiral, velocity, translate, axis;
   std::optional<double> fieldStrength;
   std::string field = "none", pose = "skewed";
+  jello::ContactFlags contact;
   bool noPlane = false, legacy = false;
 };
 
@@ -70,6 +72,7 @@ void addConstants(CLI::App& app, jello::SceneSpec& spec, Flags& f) {
   app.add_option("--d-collision", spec.dCollision, "Contact damping, N*s/m")
       ->check(jello::cli::nonNegative())
       ->capture_default_str();
+  jello::addContactFlags(app, f.contact, "default penalty; another is an extension");
   app.add_option("--mass", spec.mass, "Mass of each point, kg (default 1/512)")
       ->check(jello::cli::positive());
 }
@@ -142,6 +145,9 @@ std::string apply(Flags& f, jello::SceneSpec& spec) {
     return "unknown integrator '" + f.integrator + "' (known: " + jello::integratorNameList() + ")";
   }
   spec.integrator = *kind;
+  if (std::string error = jello::applyContactFlags(f.contact, spec.contact); !error.empty()) {
+    return error;
+  }
   f.field = CLI::detail::to_lower(f.field);
   spec.field = kFields.at(f.field);
   spec.pose = kPoses.at(CLI::detail::to_lower(f.pose));

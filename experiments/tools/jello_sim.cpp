@@ -19,6 +19,7 @@
 #include "experiments/common/modes.h"
 #include "experiments/common/progress.h"
 #include "experiments/common/signal_handler.h"
+#include "experiments/tools/contact_flags.h"
 #include "experiments/tools/output_check.h"
 #include "experiments/tools/solver_flags.h"
 #include "solvers/linalg/solver_threads.h"
@@ -59,6 +60,7 @@ struct Options {
   long every = 100;
   bool quiet = false;
   jello::SolverOptions solver;  // from the solver flags (solver_flags.h)
+  jello::ContactFlags contact;  // over the file's (contact_flags.h)
   jello::ReaderLimits limits;
 };
 
@@ -197,6 +199,9 @@ nlohmann::json statistics(const Options& opt, const Simulation& sim, const Outco
       {"world", opt.world},
       {"integrator", std::string(jello::integratorName(sim.integratorKind()))},
       {"dt_s", sim.dt()},
+      {"contact",
+       {{"model", std::string(jello::contactModelName(sim.world().contact.model))},
+        {"layer_m", sim.world().contact.layer}}},
       {"points", s.numPoints()},
       {"springs", sim.model().springs().numSprings()},
       {"steps", o.done},
@@ -303,6 +308,10 @@ int run(const Options& opt) {
   if (!jello::checkOutputs("jello-sim", outputs)) return kExitInput;
   std::optional<jello::World> world = loadWorld(opt);
   if (!world) return kExitInput;
+  if (std::string error = jello::applyContactFlags(opt.contact, world->contact); !error.empty()) {
+    std::fprintf(stderr, "jello-sim: error: %s\n", error.c_str());
+    return kExitUsage;
+  }
   std::optional<jello::IntegratorKind> kind;
   if (!opt.integrator.empty()) {
     kind = jello::parseIntegratorName(opt.integrator);
@@ -352,6 +361,7 @@ std::optional<int> parseCommandLine(int argc, char** argv, Options& opt) {
                  "Integrator, overriding the file's: " + jello::integratorNameList());
   app.add_option("--dt", opt.dt, "Time step in seconds, overriding the file's")
       ->check(jello::cli::positive());
+  jello::addContactFlags(app, opt.contact, "overriding the file's");
   auto* time = app.add_option("--time", opt.time, "Simulated time to run, s (default 1)")
                    ->check(jello::cli::positive());
   app.add_option("--steps", opt.steps, "Number of steps to run instead of --time")

@@ -41,8 +41,8 @@ bool WallContact::allInside(const double* __restrict x, int n, int lo, int hi) {
   return outside == 0;
 }
 
-bool WallContact::addForces(const double* __restrict x, const double* __restrict v,
-                            double* __restrict f, int n, int lo, int hi) const {
+bool WallContact::addPenaltyForces(const double* __restrict x, const double* __restrict v,
+                                   double* __restrict f, int n, int lo, int hi) const {
   if (allInside(x, n, lo, hi)) return false;
   const double k = constants().stiffness, c = constants().damping;
   for (int e = 0; e < 3; ++e)
@@ -54,7 +54,7 @@ bool WallContact::addForces(const double* __restrict x, const double* __restrict
   return true;
 }
 
-double WallContact::energy(const double* x, int n) const {
+double WallContact::penaltyEnergy(const double* x, int n) const {
   double e = 0.0;
   for (int i = 0; i < 3 * n; ++i) {
     const double depth = std::max(0.0, std::abs(x[i]) - kBoxHalfSize);
@@ -63,13 +63,28 @@ double WallContact::energy(const double* x, int n) const {
   return 0.5 * constants().stiffness * e;
 }
 
-void WallContact::addJacobian(const double* x, int n, JacobianBlocks& out) const {
+void WallContact::addPenaltyJacobian(const double* x, int n, JacobianBlocks& out) const {
   for (int axis = 0; axis < 3; ++axis)
     for (int p = 0; p < n; ++p) {
       if (std::abs(x[axis * n + p]) <= kBoxHalfSize) continue;
       blockOf(out.diagK, p)[4 * axis] -= constants().stiffness;  // entry (axis, axis)
       blockOf(out.diagD, p)[4 * axis] -= constants().damping;
     }
+}
+
+int WallContact::penetrations(const Vec3& x, Penetration* out) const {
+  const double c[3] = {x.x, x.y, x.z};
+  int count = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double over = std::abs(c[axis]) - kBoxHalfSize;
+    if (!(over > 0.0)) continue;
+    Penetration& q = out[count++];
+    q = Penetration{};
+    q.depth = over;
+    const double sign = c[axis] > 0.0 ? 1.0 : -1.0;
+    q.gradient = Vec3{axis == 0 ? sign : 0.0, axis == 1 ? sign : 0.0, axis == 2 ? sign : 0.0};
+  }
+  return count;
 }
 
 double WallContact::depth(const Vec3& x) const {
@@ -113,8 +128,8 @@ PlaneContact::PlaneContact(const Plane& plane, ContactConstants k) : Obstacle(k)
   offset_ = (plane.d / scale) / len;
 }
 
-bool PlaneContact::addForces(const double* __restrict x, const double* __restrict v,
-                             double* __restrict f, int n, int lo, int hi) const {
+bool PlaneContact::addPenaltyForces(const double* __restrict x, const double* __restrict v,
+                                    double* __restrict f, int n, int lo, int hi) const {
   const double ux = normal_.x, uy = normal_.y, uz = normal_.z;
   const double k = constants().stiffness, c = constants().damping;
   for (int p = lo; p < hi; ++p) {
@@ -128,7 +143,7 @@ bool PlaneContact::addForces(const double* __restrict x, const double* __restric
   return true;
 }
 
-double PlaneContact::energy(const double* x, int n) const {
+double PlaneContact::penaltyEnergy(const double* x, int n) const {
   double e = 0.0;
   for (int p = 0; p < n; ++p) {
     const double dist =
@@ -138,13 +153,22 @@ double PlaneContact::energy(const double* x, int n) const {
   return 0.5 * constants().stiffness * e;
 }
 
-void PlaneContact::addJacobian(const double* x, int n, JacobianBlocks& out) const {
+void PlaneContact::addPenaltyJacobian(const double* x, int n, JacobianBlocks& out) const {
   for (int p = 0; p < n; ++p) {
     const Vec3 xp{x[p], x[n + p], x[2 * n + p]};
     if (dot(normal_, xp) + offset_ >= 0.0) continue;
     addOuter(blockOf(out.diagK, p), normal_, -constants().stiffness);
     addOuter(blockOf(out.diagD, p), normal_, -constants().damping);
   }
+}
+
+int PlaneContact::penetrations(const Vec3& x, Penetration* out) const {
+  const double s = side(x);
+  if (!(s < 0.0)) return 0;
+  out[0] = Penetration{};
+  out[0].depth = -s;
+  out[0].gradient = normal_ * -1.0;
+  return 1;
 }
 
 double PlaneContact::depth(const Vec3& x) const {
@@ -173,8 +197,8 @@ void PlaneContact::roots(const double* x, int n, double* g) const {
   for (int p = 0; p < n; ++p) g[p] = u.x * x[p] + u.y * x[n + p] + u.z * x[2 * n + p] + offset_;
 }
 
-bool SphereContact::addForces(const double* x, const double* v, double* f, int n, int lo,
-                              int hi) const {
+bool SphereContact::addPenaltyForces(const double* x, const double* v, double* f, int n, int lo,
+                                     int hi) const {
   const Vec3 c = sphere_.center;
   const double r = sphere_.radius;
   for (int p = lo; p < hi; ++p) {
@@ -192,7 +216,7 @@ bool SphereContact::addForces(const double* x, const double* v, double* f, int n
   return true;
 }
 
-double SphereContact::energy(const double* x, int n) const {
+double SphereContact::penaltyEnergy(const double* x, int n) const {
   double e = 0.0;
   for (int p = 0; p < n; ++p) {
     const Vec3 d{x[p] - sphere_.center.x, x[n + p] - sphere_.center.y,
@@ -203,7 +227,7 @@ double SphereContact::energy(const double* x, int n) const {
   return 0.5 * constants().stiffness * e;
 }
 
-void SphereContact::addJacobian(const double* x, int n, JacobianBlocks& out) const {
+void SphereContact::addPenaltyJacobian(const double* x, int n, JacobianBlocks& out) const {
   const double R = sphere_.radius;
   for (int p = 0; p < n; ++p) {
     const Vec3 r = Vec3{x[p], x[n + p], x[2 * n + p]} - sphere_.center;
@@ -217,6 +241,24 @@ void SphereContact::addJacobian(const double* x, int n, JacobianBlocks& out) con
     for (int e = 0; e < 3; ++e) K[4 * e] += t;
     addOuter(blockOf(out.diagD, p), u, -constants().damping);
   }
+}
+
+int SphereContact::penetrations(const Vec3& x, Penetration* out) const {
+  const Vec3 r = x - sphere_.center;
+  const double l = norm(r);
+  if (!(l < sphere_.radius)) return 0;
+  Penetration& q = out[0];
+  q = Penetration{};
+  q.depth = sphere_.radius - l;
+  if (l > 0.0) {
+    const Vec3 u = r * (1.0 / l);
+    q.gradient = u * -1.0;
+    for (int e = 0; e < 3; ++e) q.hessian[4 * e] -= 1.0 / l;
+    addOuter(q.hessian, u, 1.0 / l);
+  } else {
+    q.gradient = Vec3{0.0, 0.0, -1.0};  // the centre: pushed up, as the penalty does
+  }
+  return 1;
 }
 
 double SphereContact::depth(const Vec3& x) const {

@@ -22,10 +22,16 @@ class WallContact final : public Obstacle {
   static bool allInside(const double* x, int n) { return allInside(x, n, 0, n); }
   static bool allInside(const double* x, int n, int lo, int hi);
   // Each component is its own pair of walls: normal -/+ e_c, so the spring acts on it alone.
-  bool addForces(const double* x, const double* v, double* f, int n, int lo, int hi) const override;
-  double energy(const double* x, int n) const override;
+  bool addPenaltyForces(const double* x, const double* v, double* f, int n, int lo,
+                        int hi) const override;
+  double penaltyEnergy(const double* x, int n) const override;
   // K = -kc e_c e_c^T, D = -dc e_c e_c^T on the diagonal block of each violated wall's point.
-  void addJacobian(const double* x, int n, JacobianBlocks& out) const override;
+  void addPenaltyJacobian(const double* x, int n, JacobianBlocks& out) const override;
+  bool mayTouch(const double* x, int n, int lo, int hi) const override {
+    return !allInside(x, n, lo, hi);
+  }
+  // One per wall passed: depth |x_c| - 2, gradient sign(x_c) e_c.
+  int penetrations(const Vec3& x, Penetration* out) const override;
   double depth(const Vec3& x) const override;
   bool contactBegins(const double* x0, const double* x1, int n) const override;
   int contactSprings(const Vec3& x) const override;
@@ -41,10 +47,13 @@ class PlaneContact final : public Obstacle {
  public:
   PlaneContact(const Plane& plane, ContactConstants k);
   ObstacleKind kind() const override { return ObstacleKind::Plane; }
-  bool addForces(const double* x, const double* v, double* f, int n, int lo, int hi) const override;
-  double energy(const double* x, int n) const override;
+  bool addPenaltyForces(const double* x, const double* v, double* f, int n, int lo,
+                        int hi) const override;
+  double penaltyEnergy(const double* x, int n) const override;
   // K = -kc n n^T, D = -dc n n^T for each point on the solid side.
-  void addJacobian(const double* x, int n, JacobianBlocks& out) const override;
+  void addPenaltyJacobian(const double* x, int n, JacobianBlocks& out) const override;
+  // Depth -(n.x + offset), gradient -n.
+  int penetrations(const Vec3& x, Penetration* out) const override;
   double depth(const Vec3& x) const override;
   bool contactBegins(const double* x0, const double* x1, int n) const override;
   int contactSprings(const Vec3& x) const override;
@@ -68,11 +77,14 @@ class SphereContact final : public Obstacle {
   SphereContact(const Sphere& sphere, ContactConstants k) : Obstacle(k), sphere_(sphere) {}
   ObstacleKind kind() const override { return ObstacleKind::Sphere; }
   const Sphere& sphere() const { return sphere_; }
-  bool addForces(const double* x, const double* v, double* f, int n, int lo, int hi) const override;
-  double energy(const double* x, int n) const override;
+  bool addPenaltyForces(const double* x, const double* v, double* f, int n, int lo,
+                        int hi) const override;
+  double penaltyEnergy(const double* x, int n) const override;
   // For each point inside, n radial: K = -kc n n^T + kc (R/l - 1)(I - n n^T) (the second term
   // is the surface's curvature; positive, so the clamp drops it), D = -dc n n^T.
-  void addJacobian(const double* x, int n, JacobianBlocks& out) const override;
+  void addPenaltyJacobian(const double* x, int n, JacobianBlocks& out) const override;
+  // Depth R - l, gradient -n, Hessian -(I - n n^T)/l (at the centre: pushed up, no Hessian).
+  int penetrations(const Vec3& x, Penetration* out) const override;
   double depth(const Vec3& x) const override;
   bool contactBegins(const double* x0, const double* x1, int n) const override;
   int contactSprings(const Vec3& x) const override;

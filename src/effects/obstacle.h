@@ -1,12 +1,15 @@
 // The solids a point can be pushed out of, one interface (house style: a closed set is one
-// table). Each obstacle is a geometry with the course's penalty contact (src/PHYSICS.md): a
-// point on the solid side of its surface gets a rest-length-0 spring to it,
-//   energy = 1/2 kc depth^2,   f = -kc depth grad(depth) - dc (n.v) n,
-// and answers every question the model and the solvers ask of contact (forces, energy,
-// Jacobian, depth, onset, the contact weights of the projective matrices, CVODE's root
-// functions), so Model, solvers/cvode/, solvers/system/implicit_system.cpp and
-// solvers/methods/projective_integrator.cpp iterate Model::obstacles() and name none of them.
-// The implementations: walls, plane and sphere in contact.h, cone and spiral in obstacles.h.
+// table). Each obstacle is a geometry with contact by one of the laws of src/world/
+// contact_law.h (src/PHYSICS.md): a point on the solid side of its surface, at depth q, has
+//   energy = e(q),   f = -e'(q) grad(q) - dc w(q) (n.v) n,
+// with n the unit normal into free space; the course's penalty is e = 1/2 kc q^2 and w = 1 (a
+// rest-length-0 spring to the surface), the smooth law rises over a layer (contact_law.h) with
+// w = e''/kc, so its damping starts from 0 at the surface as its stiffness does. It answers every
+// question the model and the solvers ask of contact (forces, energy, Jacobian, depth, onset, the
+// contact weights of the projective matrices, CVODE's root functions), so Model, solvers/cvode/,
+// solvers/system/implicit_system.cpp and solvers/methods/projective_integrator.cpp iterate
+// Model::obstacles() and name none of them. The implementations: walls, plane and sphere in
+// contact.h, cone and spiral in obstacles.h.
 #pragma once
 
 #include <array>
@@ -16,6 +19,7 @@
 
 #include "src/base/vec3.h"
 #include "src/effects/jacobian_blocks.h"
+#include "src/world/contact_law.h"
 
 namespace jello {
 
@@ -42,7 +46,30 @@ std::string_view obstacleName(ObstacleKind kind);
 struct ContactConstants {
   double stiffness = 0.0;  // N/m (kCollision)
   double damping = 0.0;    // N*s/m (dCollision)
+  ContactModel model = ContactModel::Penalty;
+  double layer = 0.0;  // m, the smooth law's layer
 };
+
+// A contact's depth e(q) law at depth q > 0: energy (J), its first derivative (N: the force's
+// magnitude along the depth's gradient) and second (N/m: the stiffness along it).
+struct ContactLawValue {
+  double energy = 0.0;
+  double force = 0.0;
+  double stiffness = 0.0;
+};
+// The smooth law (src/world/contact_law.h): q < layer: kc q^3 / (6 layer); beyond, the
+// quadratic with the same value, slope and curvature at q = layer, kc/2 (q - layer/2)^2 +
+// kc layer^2 / 24. Its energy is C2 in q, 0 with its derivatives at the surface.
+ContactLawValue smoothContactLaw(double depth, double stiffness, double layer);
+
+// One contact of a point: how deep it is inside a solid, and the depth's derivatives.
+struct Penetration {
+  double depth = 0.0;                               // m, > 0
+  Vec3 gradient;                                    // of the depth (points into the solid)
+  double hessian[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};  // row-major, of the depth
+};
+// At most this many contacts per point and obstacle (the walls: one per axis).
+inline constexpr int kMaxPenetrations = 3;
 
 // All arrays are 3n, component-major (x of every point, then y, then z); [lo, hi) a range of
 // points (Model splits them over threads).
@@ -55,17 +82,31 @@ class Obstacle {
 
   // Adds the contact forces (N) of the points [lo, hi) to f. False when it skipped them all
   // after a cheap check that none touches (the walls'; the others always evaluate).
-  virtual bool addForces(const double* x, const double* v, double* f, int n, int lo,
-                         int hi) const = 0;
+  bool addForces(const double* x, const double* v, double* f, int n, int lo, int hi) const {
+    return k_.model == ContactModel::Penalty ? addPenaltyForces(x, v, f, n, lo, hi)
+                                             : addLawForces(x, v, f, n, lo, hi);
+  }
   // The same for all n points.
   void accumulate(const double* x, const double* v, double* f, int n) const {
     addForces(x, v, f, n, 0, n);
   }
   // The contact energy (J) of all n points.
-  virtual double energy(const double* x, int n) const = 0;
+  double energy(const double* x, int n) const {
+    return k_.model == ContactModel::Penalty ? penaltyEnergy(x, n) : lawEnergy(x, n);
+  }
   // K = df/dx and D = df/dv on each touching point's diagonal block (src/effects/
-  // jacobian_blocks.h); the curvature term is dropped under the clamp.
-  virtual void addJacobian(const double* x, int n, JacobianBlocks& out) const = 0;
+  // jacobian_blocks.h): K = -(e'' g g^T + e' Hess(q)), D = -dc w n n^T; the curvature term
+  // e' Hess(q) is dropped under the clamp.
+  void addJacobian(const double* x, int n, JacobianBlocks& out) const {
+    if (k_.model == ContactModel::Penalty) {
+      addPenaltyJacobian(x, n, out);
+    } else {
+      addLawJacobian(x, n, out);
+    }
+  }
+  // Writes each contact x has with this solid (at most kMaxPenetrations) to out; returns how
+  // many.
+  virtual int penetrations(const Vec3& x, Penetration* out) const = 0;
 
   // How deep x is inside the solid (m): > 0 in contact, 0 in free space (the walls: the
   // deepest of the walls it passed).
@@ -88,6 +129,17 @@ class Obstacle {
   virtual void roots(const double* /*x*/, int /*n*/, double* /*g*/) const {}
 
  protected:
+  // The course's penalty, written out per solid (vectorized where it runs in every force
+  // evaluation); the other laws go through penetrations().
+  virtual bool addPenaltyForces(const double* x, const double* v, double* f, int n, int lo,
+                                int hi) const = 0;
+  virtual double penaltyEnergy(const double* x, int n) const = 0;
+  virtual void addPenaltyJacobian(const double* x, int n, JacobianBlocks& out) const = 0;
+  // False when no point of [lo, hi) can touch (a cheap check; the walls').
+  virtual bool mayTouch(const double* /*x*/, int /*n*/, int /*lo*/, int /*hi*/) const {
+    return true;
+  }
+
   // addContactWeights of a solid whose spring reaches every coordinate: w[c][p] += weight on
   // all three where inside(p), p in [lo, hi).
   template <class Inside>
@@ -100,6 +152,12 @@ class Obstacle {
   }
 
  private:
+  // The law's value at depth q (not the penalty's, which has its own loops).
+  ContactLawValue law(double depth) const;
+  bool addLawForces(const double* x, const double* v, double* f, int n, int lo, int hi) const;
+  double lawEnergy(const double* x, int n) const;
+  void addLawJacobian(const double* x, int n, JacobianBlocks& out) const;
+
   ContactConstants k_;
 };
 

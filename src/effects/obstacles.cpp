@@ -146,8 +146,8 @@ std::optional<Penetration> ObstacleContact::penetration(const Vec3& x) const {
   return cone_ ? conePenetration(*cone_, x) : spiralPenetration(*spiral_, x);
 }
 
-bool ObstacleContact::addForces(const double* x, const double* v, double* f, int n, int lo,
-                                int hi) const {
+bool ObstacleContact::addPenaltyForces(const double* x, const double* v, double* f, int n, int lo,
+                                       int hi) const {
   const ContactConstants& k = constants();
   for (int p = lo; p < hi; ++p) {
     const std::optional<Penetration> q = penetration(pointAt(x, n, p));
@@ -162,7 +162,7 @@ bool ObstacleContact::addForces(const double* x, const double* v, double* f, int
   return true;
 }
 
-double ObstacleContact::energy(const double* x, int n) const {
+double ObstacleContact::penaltyEnergy(const double* x, int n) const {
   double e = 0.0;
   for (int p = 0; p < n; ++p) {
     if (const std::optional<Penetration> q = penetration(pointAt(x, n, p)))
@@ -171,7 +171,7 @@ double ObstacleContact::energy(const double* x, int n) const {
   return 0.5 * constants().stiffness * e;
 }
 
-void ObstacleContact::addJacobian(const double* x, int n, JacobianBlocks& out) const {
+void ObstacleContact::addPenaltyJacobian(const double* x, int n, JacobianBlocks& out) const {
   const ContactConstants& k = constants();
   for (int p = 0; p < n; ++p) {
     const std::optional<Penetration> q = penetration(pointAt(x, n, p));
@@ -184,6 +184,12 @@ void ObstacleContact::addJacobian(const double* x, int n, JacobianBlocks& out) c
     const Vec3 nrm = unitVector(q->gradient * -1.0);
     setOuter(out.diagD + 9 * p, nrm, nrm, -k.damping);
   }
+}
+
+int ObstacleContact::penetrations(const Vec3& x, Penetration* out) const {
+  const std::optional<Penetration> q = penetration(x);
+  if (q) out[0] = *q;
+  return q ? 1 : 0;
 }
 
 double ObstacleContact::depth(const Vec3& x) const {

@@ -19,12 +19,6 @@
 
 namespace jello {
 
-struct Penetration {
-  double depth = 0.0;                               // m, > 0
-  Vec3 gradient;                                    // of the depth (points into the solid)
-  double hessian[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};  // row-major, of the depth
-};
-
 // The penetration of point x into a cone or a spiral ramp, or nothing when x is outside.
 std::optional<Penetration> conePenetration(const Cone& cone, const Vec3& x);
 std::optional<Penetration> spiralPenetration(const Spiral& spiral, const Vec3& x);
@@ -38,9 +32,11 @@ class ObstacleContact final : public Obstacle {
   ObstacleKind kind() const override { return cone_ ? ObstacleKind::Cone : ObstacleKind::Spiral; }
   std::optional<Penetration> penetration(const Vec3& x) const;
   bool inside(const Vec3& x) const { return penetration(x).has_value(); }
-  bool addForces(const double* x, const double* v, double* f, int n, int lo, int hi) const override;
-  double energy(const double* x, int n) const override;
-  void addJacobian(const double* x, int n, JacobianBlocks& out) const override;
+  bool addPenaltyForces(const double* x, const double* v, double* f, int n, int lo,
+                        int hi) const override;
+  double penaltyEnergy(const double* x, int n) const override;
+  void addPenaltyJacobian(const double* x, int n, JacobianBlocks& out) const override;
+  int penetrations(const Vec3& x, Penetration* out) const override;
   double depth(const Vec3& x) const override;
   bool contactBegins(const double* x0, const double* x1, int n) const override;
   int contactSprings(const Vec3& x) const override;

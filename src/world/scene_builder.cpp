@@ -89,6 +89,7 @@ World buildWorld(const SceneSpec& spec) {
   w.kElastic = spec.kElastic;
   w.dElastic = spec.dElastic;
   w.kCollision = spec.kCollision;
+  w.contact = spec.contact;
   w.dCollision = spec.dCollision;
   w.mass = spec.mass;
   w.plane = spec.plane;

@@ -29,6 +29,7 @@ struct SceneSpec {
   int stepsPerFrame = 1;
   double kElastic = 200.0, dElastic = 0.25;      // N/m, N*s/m
   double kCollision = 400.0, dCollision = 0.25;  // N/m, N*s/m
+  ContactLaw contact;                            // penalty
   double mass = 1.0 / 512;                       // kg per point
   std::optional<Plane> plane = Plane{-1.0, 1.0, 1.0, 2.0};
   FieldPreset field = FieldPreset::None;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "src/base/vec3.h"
+#include "src/world/contact_law.h"
 #include "src/world/integrator_table.h"
 
 namespace jello {
@@ -75,6 +76,7 @@ struct World {
   double dElastic = 0.0;    // N*s/m, their damping along the spring
   double kCollision = 0.0;  // N/m, contact penalty springs (walls, plane, sphere)
   double dCollision = 0.0;  // N*s/m, their damping along the contact normal
+  ContactLaw contact;       // extension `contact`: how contact rises with depth (penalty: as ever)
   double mass = 1.0 / 512;  // kg, of EACH point
   std::optional<Plane> plane;
   ForceField field;
@@ -90,7 +92,7 @@ struct World {
   // not read it as written).
   bool usesExtensions() const {
     return cubeResolution != kDefaultCubeResolution || sphere.has_value() || cone.has_value() ||
-           spiral.has_value() ||
+           spiral.has_value() || contact.model != ContactModel::Penalty ||
            (integrator != IntegratorKind::Euler && integrator != IntegratorKind::RK4);
   }
 };

@@ -113,6 +113,17 @@ void readSpiralExtension(Tokenizer& in, World& world, const ReaderLimits&) {
   world.spiral = s;
 }
 
+// `contact MODEL [parameters]`: penalty takes none, smooth its layer (m, > 0).
+void readContactExtension(Tokenizer& in, World& world, const ReaderLimits&) {
+  const Token name = in.next();
+  if (name.text.empty()) in.fail(name, "file ends where a contact model was expected");
+  const std::optional<ContactModel> model = contactModelFromName(name.text);
+  if (!model) in.fail(name, "unknown contact model (known: " + contactModelNames() + ")");
+  ContactLaw law{*model, 0.0};
+  if (law.model == ContactModel::Smooth) law.layer = in.positive("smooth contact layer");
+  world.contact = law;
+}
+
 struct Extension {
   std::string_view keyword;
   void (*read)(Tokenizer&, World&, const ReaderLimits&);
@@ -120,7 +131,7 @@ struct Extension {
 constexpr Extension kExtensions[] = {
     {"integrator", readIntegratorExtension}, {"cube", readCubeExtension},
     {"sphere", readSphereExtension},         {"cone", readConeExtension},
-    {"spiral", readSpiralExtension},
+    {"spiral", readSpiralExtension},         {"contact", readContactExtension},
 };
 
 const Extension* extension(std::string_view keyword) {

@@ -1,6 +1,8 @@
 #include "src/world/world_writer.h"
 
 #include <cstdio>
+#include <initializer_list>
+#include <string>
 
 #include "src/base/atomic_file.h"
 
@@ -71,29 +73,30 @@ std::string formatWorld(const World& w, NumberFormat format) {
     p.text("integrator " + std::string(integratorFileName(w.integrator)));
   }
   if (w.cubeResolution != kDefaultCubeResolution) p.textInt("cube ", w.cubeResolution);
-  if (w.sphere) {
-    std::string line = "sphere ";
+  // One line: the keyword, then its numbers.
+  const auto extension = [&](const std::string& keyword, std::initializer_list<double> numbers) {
     Printer q(format);
-    q.numbers({w.sphere->center.x, w.sphere->center.y, w.sphere->center.z, w.sphere->radius});
-    line += q.take();
-    line.pop_back();
+    q.numbers(numbers);
+    std::string line = keyword + " " + q.take();
+    line.pop_back();  // the numbers' newline
     p.text(line);
+  };
+  if (w.sphere) {
+    const Sphere& s = *w.sphere;
+    extension("sphere", {s.center.x, s.center.y, s.center.z, s.radius});
   }
   if (w.cone) {
     const Cone& c = *w.cone;
-    Printer q(format);
-    q.numbers({c.apex.x, c.apex.y, c.apex.z, c.axis.x, c.axis.y, c.axis.z, c.height, c.radius});
-    std::string line = "cone " + q.take();
-    line.pop_back();
-    p.text(line);
+    extension("cone",
+              {c.apex.x, c.apex.y, c.apex.z, c.axis.x, c.axis.y, c.axis.z, c.height, c.radius});
   }
   if (w.spiral) {
     const Spiral& s = *w.spiral;
-    Printer q(format);
-    q.numbers({s.cx, s.cy, s.zTop, s.rInner, s.rOuter, s.pitch, s.turns, s.thickness});
-    std::string line = "spiral " + q.take();
-    line.pop_back();
-    p.text(line);
+    extension("spiral", {s.cx, s.cy, s.zTop, s.rInner, s.rOuter, s.pitch, s.turns, s.thickness});
+  }
+  // Penalty, the course's contact, is what a file without the line means.
+  if (w.contact.model == ContactModel::Smooth) {
+    extension("contact " + std::string(contactModelName(w.contact.model)), {w.contact.layer});
   }
   return p.take();
 }

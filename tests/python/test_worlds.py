@@ -80,6 +80,28 @@ def test_attributes_write_and_check(jello_w, tmp_path):
         w.k = "stiff"
 
 
+def test_contact_model_is_an_attribute_and_a_create_world_keyword(jello_w, tmp_path):
+    assert jello_w.contact == "penalty" and jello_w.contact_layer == 0.0
+    w = jello_w.copy()
+    w.contact = "smooth"
+    assert w.contact_layer == 0.005  # kDefaultContactLayer
+    w.contact_layer = 0.002
+    w.save(str(tmp_path / "smooth.w"))
+    back = jello.load_world(str(tmp_path / "smooth.w"))
+    assert back == w and back != jello_w
+    assert (back.contact, back.contact_layer) == ("smooth", 0.002)
+    with pytest.raises(ValueError):
+        w.contact = "sticky"
+    with pytest.raises(ValueError):
+        w.contact_layer = -1.0
+    with pytest.raises(ValueError):
+        jello_w.copy().contact_layer = 0.01  # penalty has no layer
+    made = jello.create_world(contact="smooth", contact_layer=0.003)
+    assert (made.contact, made.contact_layer) == ("smooth", 0.003)
+    with pytest.raises(ValueError):
+        jello.create_world(contact_layer=0.003)
+
+
 def test_cube_resolution_resamples(jello_w):
     w = jello_w.copy()
     w.cube_resolution = 4

@@ -80,7 +80,7 @@ bool sameWorld(const World& a, const World& b) {
          a.field.resolution == b.field.resolution && samePoints(a.field.forces, b.field.forces) &&
          a.cubeResolution == b.cubeResolution && samePoints(a.positions, b.positions) &&
          samePoints(a.velocities, b.velocities) && sameSphere(a.sphere, b.sphere) &&
-         a.cone == b.cone && a.spiral == b.spiral;
+         a.cone == b.cone && a.spiral == b.spiral && a.contact == b.contact;
 }
 
 }  // namespace
@@ -96,12 +96,20 @@ void saveWorld(const World& w, const std::string& path, bool legacy) {
 
 namespace {
 
+// The law a model's name gives: smooth keeps a layer already set, else takes the default.
+jello::ContactLaw contactLaw(const std::string& name, double layer) {
+  const std::optional<jello::ContactModel> model = jello::contactModelFromName(name);
+  if (!model) valueError("contact must be one of " + jello::contactModelNames());
+  if (*model != jello::ContactModel::Smooth) return {*model, 0.0};
+  return {*model, layer > 0.0 ? layer : jello::kDefaultContactLayer};
+}
+
 // Long: one branch per keyword, as jello-create-world's flags.
 // jello-create-world's flags as keywords ('-' -> '_'): the same presets, and the same check
 // that the world reads back.
 World createWorld(const py::kwargs& kwargs) {
   jello::SceneSpec spec;
-  std::optional<double> fieldStrength;
+  std::optional<double> fieldStrength, contactLayer;
   for (const auto& [key, value] : kwargs) {
     const std::string name = py::cast<std::string>(key);
     const char* n = name.c_str();
@@ -122,6 +130,10 @@ World createWorld(const py::kwargs& kwargs) {
       spec.dCollision = nonNegative(real(), n);
     } else if (name == "mass") {
       spec.mass = positive(real(), n);
+    } else if (name == "contact") {
+      spec.contact = contactLaw(as<std::string>(value, name), spec.contact.layer);
+    } else if (name == "contact_layer") {
+      contactLayer = positive(real(), n);
     } else if (name == "plane") {
       if (value.is_none()) {
         spec.plane.reset();
@@ -191,8 +203,15 @@ World createWorld(const py::kwargs& kwargs) {
       valueError("unknown create_world option '" + name +
                  "' (known: integrator, dt, steps_per_frame, k_elastic, d_elastic, k_collision, "
                  "d_collision, mass, plane, field, field_strength, field_resolution, pose, "
-                 "stretch, rotate, axis, translate, velocity, spin, sphere, cube)");
+                 "stretch, rotate, axis, translate, velocity, spin, sphere, cube, contact, "
+                 "contact_layer)");
     }
+  }
+  if (contactLayer) {
+    if (spec.contact.model != jello::ContactModel::Smooth) {
+      valueError("contact_layer applies to the smooth contact model only");
+    }
+    spec.contact.layer = *contactLayer;
   }
   spec.fieldStrength = fieldStrength.value_or(jello::defaultFieldStrength(spec.field, spec.mass));
   const World world = jello::buildWorld(spec);
@@ -242,6 +261,20 @@ void bindWorlds(py::module_& m) {
           "d_collision", [](const World& w) { return w.dCollision; },
           [](World& w, double v) { w.dCollision = nonNegative(v, "d_collision"); },
           "contact damping, N*s/m")
+      .def_property(
+          "contact",
+          [](const World& w) { return std::string(jello::contactModelName(w.contact.model)); },
+          [](World& w, const std::string& name) { w.contact = contactLaw(name, w.contact.layer); },
+          "contact model: penalty (the course's) or smooth (stiffening over contact_layer)")
+      .def_property(
+          "contact_layer", [](const World& w) { return w.contact.layer; },
+          [](World& w, double layer) {
+            if (w.contact.model != jello::ContactModel::Smooth) {
+              valueError("contact_layer applies to the smooth contact model only");
+            }
+            w.contact.layer = positive(layer, "contact_layer");
+          },
+          "the smooth contact model's layer, m (0 for penalty)")
       .def_property(
           "mass", [](const World& w) { return w.mass; },
           [](World& w, double v) { w.mass = positive(v, "mass"); }, "mass of each point, kg")

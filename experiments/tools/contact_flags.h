@@ -1,0 +1,24 @@
+// The contact flags jello-create-world and jello-sim share: --contact MODEL and
+// --contact-layer M (src/world/contact_law.h). jello-sim's override the world file's.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <optional>
+#include <string>
+
+#include "src/world/contact_law.h"
+
+namespace jello {
+
+struct ContactFlags {
+  std::string model;            // empty: not given
+  std::optional<double> layer;  // m
+};
+
+// Registers both; `what` ends the model's help ("default penalty", "overriding the file's").
+void addContactFlags(CLI::App& app, ContactFlags& flags, const std::string& what);
+// Applies the flags given over `law`: a smooth model without --contact-layer keeps the law's
+// layer or takes kDefaultContactLayer. A usage error's text, or empty.
+std::string applyContactFlags(const ContactFlags& flags, ContactLaw& law);
+
+}  // namespace jello

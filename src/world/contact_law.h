@@ -1,0 +1,47 @@
+// How contact pushes a point out of a solid (src/PHYSICS.md, "Contact models"): the course's
+// penalty, whose stiffness jumps from 0 to kCollision at the surface, or a smooth penalty whose
+// energy is C2 in the depth, so its force and stiffness rise continuously over a thin layer.
+// One table; the world file's `contact` extension, jello-create-world's and jello-sim's
+// `--contact` read and write the names through it.
+#pragma once
+
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+namespace jello {
+
+// Each row: enumerator, name (world files, flags, statistics), one-line summary.
+#define JELLO_CONTACT_MODELS(X)                                                             \
+  X(Penalty, "penalty", "the course's: 1/2 kc depth^2, its stiffness jumps at the surface") \
+  X(Smooth, "smooth",                                                                       \
+    "C2 onset over a layer: kc depth^3 / (6 layer), then the penalty shifted by layer / 2")
+
+enum class ContactModel {
+#define JELLO_CONTACT_MODEL_ENUMERATOR(kind, name, summary) kind,
+  JELLO_CONTACT_MODELS(JELLO_CONTACT_MODEL_ENUMERATOR)
+#undef JELLO_CONTACT_MODEL_ENUMERATOR
+};
+
+std::string_view contactModelName(ContactModel model);
+// Every model, in the table's order.
+std::span<const ContactModel> allContactModels();
+// The model named (any case), or nothing.
+std::optional<ContactModel> contactModelFromName(std::string_view name);
+// "penalty, smooth": for help texts and messages.
+std::string contactModelNames();
+
+// m: the smooth model's layer unless a file or flag gives one; thin against the lattice's
+// spacing (1/7 m at 8^3) and thick against a resting cube's penalty depth (about 0.4 mm on
+// jello.w).
+inline constexpr double kDefaultContactLayer = 0.005;
+
+// The model and its parameters, as the world file's `contact` extension gives them.
+struct ContactLaw {
+  ContactModel model = ContactModel::Penalty;
+  double layer = 0.0;  // m, > 0 for smooth: the depth over which stiffness rises to kc
+  bool operator==(const ContactLaw&) const = default;
+};
+
+}  // namespace jello

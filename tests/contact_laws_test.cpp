@@ -1,0 +1,268 @@
+// The contact laws (src/world/contact_law.h, src/effects/obstacle.h): the smooth law is C2 in
+// the depth and its derivatives are each other's; on every solid, alone and two at a corner,
+// its forces are minus its energy's gradient and its Jacobians the forces' derivatives; every
+// solid's penetrations give back its penalty; the world file's `contact` extension round-trips
+// and bad ones are refused naming the token; a file without it is the penalty.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <fstream>
+#include <random>
+
+#include "solvers/system/jacobian.h"
+#include "src/model.h"
+#include "src/world/world_reader.h"
+#include "src/world/world_writer.h"
+#include "tests/test_support.h"
+
+namespace jello {
+namespace {
+
+constexpr double kLayer = 0.05;
+const ContactConstants kSmooth{1000.0, 0.3, ContactModel::Smooth, kLayer};
+const ContactConstants kPenalty{1000.0, 0.3};
+
+ModelSpec onePoint(const ContactConstants& k) {
+  ModelSpec spec;
+  spec.numPoints = 1;
+  spec.mass = 0.01;
+  spec.walls = false;
+  spec.contact = k;
+  return spec;
+}
+
+// One model per solid, each alone (the walls too).
+std::vector<ModelSpec> everySolid(const ContactConstants& k) {
+  std::vector<ModelSpec> specs(5, onePoint(k));
+  specs[0].walls = true;
+  specs[1].plane = Plane{-1, 1, 2, 2};
+  specs[2].sphere = Sphere{{0.1, -0.2, 0.3}, 0.9};
+  specs[3].cone = Cone{{0.2, -0.1, 0.0}, {0.1, 0.2, -1.0}, 1.8, 1.1};
+  specs[4].spiral = Spiral{0.1, -0.2, 1.0, 0.4, 1.6, 1.2, 1.5, 0.3};
+  return specs;
+}
+
+State at(const Vec3& x, const Vec3& v = {0, 0, 0}) {
+  State s;
+  s.x.resize(3);
+  s.v.resize(3);
+  State::set(s.x, 0, x);
+  State::set(s.v, 0, v);
+  return s;
+}
+
+// Random points of [-2.1, 2.1]^3 touching the model's one solid at depth in [1e-3, deepest],
+// away from where its nearest face changes (there the force is continuous but its Jacobian
+// jumps).
+std::vector<Vec3> touchingPoints(const Obstacle& o, double deepest, int count) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-2.1, 2.1);
+  std::vector<Vec3> points;
+  Penetration a[kMaxPenetrations], b[kMaxPenetrations];
+  for (long tries = 0; int(points.size()) < count && tries < 10000000; ++tries) {
+    const Vec3 x{u(rng), u(rng), u(rng)};
+    if (o.penetrations(x, a) != 1 || a[0].depth < 1e-3 || a[0].depth > deepest) continue;
+    bool same = true;
+    for (const Vec3& d : {Vec3{1e-4, 0, 0}, Vec3{0, 1e-4, 0}, Vec3{0, 0, 1e-4}}) {
+      for (double s : {-1.0, 1.0}) {
+        same =
+            same && o.penetrations(x + d * s, b) == 1 && norm(b[0].gradient - a[0].gradient) < 1e-2;
+      }
+    }
+    if (same) points.push_back(x);
+  }
+  EXPECT_EQ(int(points.size()), count);
+  return points;
+}
+
+double relativeError(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).cwiseAbs().maxCoeff() / std::max(1e-12, b.cwiseAbs().maxCoeff());
+}
+
+// f = -grad(E) at rest; K against differences of the force at rest (the damping's dependence on
+// x is left out of K: at rest it is 0), D against differences in the velocity while moving.
+void expectConsistent(const Model& model, const Vec3& x) {
+  const double h = 1e-6;
+  const State s = at(x);
+  Eigen::VectorXd f, fp, fm;
+  model.forces(s.x, s.v, f);
+  Eigen::Vector3d grad;
+  Eigen::MatrixXd K(3, 3), D(3, 3);
+  const State moving = at(x, {0.4, -0.7, 0.3});
+  for (int j = 0; j < 3; ++j) {
+    State p = s, m = s;
+    p.x[j] += h;
+    m.x[j] -= h;
+    grad[j] = (model.potentialEnergy(p.x.data()) - model.potentialEnergy(m.x.data())) / (2 * h);
+    model.forces(p.x, p.v, fp);
+    model.forces(m.x, m.v, fm);
+    K.col(j) = (fp - fm) / (2 * h);
+    State pv = moving, mv = moving;
+    pv.v[j] += h;
+    mv.v[j] -= h;
+    model.forces(pv.x, pv.v, fp);
+    model.forces(mv.x, mv.v, fm);
+    D.col(j) = (fp - fm) / (2 * h);
+  }
+  const std::string where =
+      std::to_string(x.x) + " " + std::to_string(x.y) + " " + std::to_string(x.z);
+  EXPECT_LT((f + grad).norm(), 1e-6 * std::max(1.0, f.norm())) << where;
+  JacobianAssembler jac(model);
+  jac.assemble(moving.x.data(), {.clampCompression = false});
+  EXPECT_LT(relativeError(Eigen::MatrixXd(jac.K()), K), 1e-5) << where;
+  EXPECT_LT(relativeError(Eigen::MatrixXd(jac.D()), D), 1e-6) << where;
+  // Clamped, -K is semidefinite.
+  jac.assemble(moving.x.data(), {});
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(-Eigen::MatrixXd(jac.K()))
+                .eigenvalues()
+                .minCoeff(),
+            -1e-9)
+      << where;
+}
+
+TEST(SmoothContactLaw, IsC2InTheDepthAndZeroWithItsDerivativesAtTheSurface) {
+  const double k = 1000.0, layer = 0.01;
+  const ContactLawValue surface = smoothContactLaw(0.0, k, layer);
+  EXPECT_EQ(surface.energy, 0.0);
+  EXPECT_EQ(surface.force, 0.0);
+  EXPECT_EQ(surface.stiffness, 0.0);
+  EXPECT_EQ(smoothContactLaw(-0.1, k, layer).energy, 0.0);  // outside: nothing
+  // Value, slope and curvature agree on both sides of the layer's end.
+  const ContactLawValue below = smoothContactLaw(layer * (1 - 1e-12), k, layer);
+  const ContactLawValue above = smoothContactLaw(layer * (1 + 1e-12), k, layer);
+  EXPECT_NEAR(below.energy, above.energy, 1e-10 * above.energy);
+  EXPECT_NEAR(below.force, above.force, 1e-9 * above.force);
+  EXPECT_NEAR(below.stiffness, above.stiffness, 1e-9 * above.stiffness);
+  EXPECT_DOUBLE_EQ(above.stiffness, k);  // past the layer: the penalty's stiffness
+  // Deep, the penalty shifted by half the layer: the same force kc layer/2 shallower.
+  EXPECT_NEAR(smoothContactLaw(0.3, k, layer).force, k * (0.3 - layer / 2), 1e-9);
+  // Each derivative is the one before's, by central differences, inside and past the layer.
+  for (double q : {0.001, 0.004, 0.0099, 0.0101, 0.02, 0.5}) {
+    const double h = 1e-7;
+    const ContactLawValue p = smoothContactLaw(q + h, k, layer),
+                          m = smoothContactLaw(q - h, k, layer);
+    const ContactLawValue c = smoothContactLaw(q, k, layer);
+    EXPECT_NEAR((p.energy - m.energy) / (2 * h), c.force, 1e-6 * std::max(1.0, c.force)) << q;
+    EXPECT_NEAR((p.force - m.force) / (2 * h), c.stiffness, 1e-5 * std::max(1.0, c.stiffness)) << q;
+  }
+}
+
+TEST(SmoothContact, ForcesAndJacobiansMatchFiniteDifferencesOnEverySolid) {
+  for (const ModelSpec& spec : everySolid(kSmooth)) {
+    const Model model(spec);
+    ASSERT_EQ(model.obstacles().size(), 1u);
+    const Obstacle& o = *model.obstacles()[0];
+    SCOPED_TRACE(std::string(obstacleName(o.kind())));
+    // Inside the layer (where the law is cubic) and past it.
+    for (const Vec3& x : touchingPoints(o, kLayer, 12)) expectConsistent(model, x);
+    for (const Vec3& x : touchingPoints(o, 10.0, 12)) expectConsistent(model, x);
+  }
+}
+
+TEST(SmoothContact, ForcesAndJacobiansMatchFiniteDifferencesWithinTheLayerOfTwoOrThreeSolids) {
+  ModelSpec spec = onePoint(kSmooth);
+  spec.walls = true;
+  spec.plane = Plane{0, 0, 1, 1.97};  // the floor raised 3 cm
+  const Model model(spec);
+  for (const Vec3& x : {Vec3{2.01, -2.03, 0.5},       // two walls, inside both layers
+                        Vec3{2.03, 2.04, -1.99},      // a wall and the plane
+                        Vec3{-2.02, 2.01, -2.04}}) {  // two walls, the plane and the floor
+    expectConsistent(model, x);
+  }
+}
+
+// Every solid's penetrations say what its penalty does: energy 1/2 kc q^2 and force
+// -kc q grad(q) summed over them.
+TEST(SmoothContact, PenetrationsGiveBackEverySolidsPenalty) {
+  for (const ModelSpec& spec : everySolid(kPenalty)) {
+    const Model model(spec);
+    const Obstacle& o = *model.obstacles()[0];
+    SCOPED_TRACE(std::string(obstacleName(o.kind())));
+    Penetration touch[kMaxPenetrations];
+    for (const Vec3& x : touchingPoints(o, 10.0, 20)) {
+      const State s = at(x);
+      double energy = 0.0;
+      Vec3 force;
+      const int count = o.penetrations(x, touch);
+      for (int i = 0; i < count; ++i) {
+        energy += 0.5 * 1000.0 * touch[i].depth * touch[i].depth;
+        force = force + touch[i].gradient * (-1000.0 * touch[i].depth);
+        // Exact distances have unit gradients; the spiral's vertical depth sqrt(1 + c^2/r^2).
+        if (o.kind() != ObstacleKind::Spiral) {
+          EXPECT_NEAR(norm(touch[i].gradient), 1.0, 1e-12);
+        }
+      }
+      EXPECT_NEAR(o.energy(s.x.data(), 1), energy, 1e-12 * energy);
+      Eigen::VectorXd f;
+      model.forces(s.x, s.v, f);
+      EXPECT_LT(norm(Vec3{f[0], f[1], f[2]} - force), 1e-9 * norm(force));
+      EXPECT_NEAR(o.depth(x), touch[0].depth, 1e-12);
+    }
+  }
+}
+
+// At the surface the penalty's stiffness jumps to kc while the smooth law's starts from 0.
+TEST(SmoothContact, StiffnessRisesFromZeroAtTheSurfaceWhereThePenaltysJumps) {
+  for (const ContactConstants& k : {kPenalty, kSmooth}) {
+    ModelSpec spec = onePoint(k);
+    spec.plane = Plane{0, 0, 1, 0};
+    const Model model(spec);
+    JacobianAssembler jac(model);
+    const State s = at({0.1, 0.2, -1e-9}, {0, 0, -1.0});
+    jac.assemble(s.x.data(), {});
+    const double kzz = -Eigen::MatrixXd(jac.K())(2, 2), dzz = -Eigen::MatrixXd(jac.D())(2, 2);
+    if (k.model == ContactModel::Penalty) {
+      EXPECT_EQ(kzz, 1000.0);
+      EXPECT_EQ(dzz, 0.3);
+    } else {
+      EXPECT_NEAR(kzz, 1000.0 * 1e-9 / kLayer, 1e-12);  // kc q / layer
+      EXPECT_NEAR(dzz, 0.3 * 1e-9 / kLayer, 1e-15);     // dc w, w = q / layer
+    }
+  }
+}
+
+TEST(ContactWorlds, TheContactExtensionRoundTripsAndBadOnesAreRefused) {
+  test::TempDir dir;
+  const World plain = test::loadWorld("jello.w");
+  EXPECT_EQ(plain.contact, ContactLaw{});  // no extension: the penalty
+  World w = plain;
+  w.contact = {ContactModel::Smooth, 0.0042};
+  const std::string line = "contact smooth 0.0041999999999999997";  // %.17g
+  EXPECT_TRUE(w.usesExtensions());
+  const auto path = dir.path() / "smooth.w";
+  writeWorld(w, path);
+  EXPECT_EQ(readWorld(path).contact, w.contact);
+  const std::string text = test::readFile(path);
+  EXPECT_NE(text.find("\n" + line + "\n"), std::string::npos);
+  // A world with the penalty is written without the line: the course's file.
+  writeWorld(plain, dir.path() / "plain.w");
+  EXPECT_EQ(test::readFile(dir.path() / "plain.w").find("contact"), std::string::npos);
+
+  const auto refused = [&](const std::string& badLine, const std::string& why) {
+    std::string bad = text;
+    bad.replace(bad.find(line), line.size(), badLine);
+    const auto badPath = dir.path() / "bad.w";
+    std::ofstream(badPath) << bad;
+    try {
+      (void)readWorld(badPath);
+      ADD_FAILURE() << "accepted: " << badLine;
+    } catch (const WorldFileError& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("bad.w:"), std::string::npos) << e.what();
+    }
+  };
+  refused("contact sticky", "unknown contact model (known: penalty, smooth)");
+  refused("contact smooth -0.01", "smooth contact layer");
+  refused("contact smooth 0", "smooth contact layer");
+  refused("contact smooth", "smooth contact layer");
+  refused("contact", "contact model was expected");
+  refused("contact penalty contact smooth 0.1", "given twice");
+  // Spelled in any case, as integrators are.
+  std::string upper = text;
+  upper.replace(upper.find("contact smooth"), 14, "contact SMOOTH");
+  std::ofstream(dir.path() / "upper.w") << upper;
+  EXPECT_EQ(readWorld(dir.path() / "upper.w").contact, w.contact);
+}
+
+}  // namespace
+}  // namespace jello
