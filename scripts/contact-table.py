@@ -6,7 +6,7 @@ world, kElastic 2e4 N/m at dt = 0.01 s, written by jello-create-world; worlds/sh
 every integrator that ends its steps in Newton's iterations, with each contact model of
 src/world/contact_law.h (`--contact`, the smooth one at its default layer), and writes
 experiments/results/contact_models.json: per run the steps, the steps left unconverged at the
-Newton cap, Newton iterations per step and the energy at the start and the end. The README's
+Newton cap after the retries in half steps, the (sub-)steps retried, Newton iterations per step and the energy at the start and the end. The README's
 contact table (scripts/results-tables.py, block contact-newton) is made from that file alone.
 
     scripts/contact-table.py [--bin build/native/bin]
@@ -57,6 +57,7 @@ def run(bin_dir, world, steps, integrator, model, tmp):
     solver = s.get("solver", {})
     return {"steps": s["steps"], "diverged": s["diverged"],
             "unconverged_steps": int(solver.get("newton_unconverged_steps", 0)),
+            "retried_steps": int(solver.get("newton_retried_steps", 0)),
             "newton_per_step": solver.get("newton_iterations_per_step", 0.0),
             "energy_start_J": s["energy_start"]["total_J"],
             "energy_end_J": s["energy_end"]["total_J"],

@@ -622,13 +622,14 @@ def contact_newton():
     runs = data["runs"]
     models = list(dict.fromkeys(r["contact"] for r in runs))
     head = "| scene | integrator | " + " | ".join(
-        f"{m}: unconverged, Newton/step" for m in models) + " |"
+        f"{m}: unconverged (retried), Newton/step" for m in models) + " |"
     lines = [head, "|---|---|" + "---|" * len(models)]
     cells = {}
     for r in runs:
         cells.setdefault((r["scene"], r["integrator"]), {})[r["contact"]] = r
     for (scene, integrator), by_model in cells.items():
-        row = [f"{r['unconverged_steps']} of {r['steps']}, {r['newton_per_step']:.1f}"
+        row = [f"{r['unconverged_steps']} of {r['steps']} ({r['retried_steps']}), "
+               f"{r['newton_per_step']:.1f}"
                + (" (diverged)" if r["diverged"] else "")
                for r in (by_model[m] for m in models)]
         lines.append(f"| {scene} | `{integrator}` | " + " | ".join(row) + " |")

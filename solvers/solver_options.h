@@ -12,7 +12,10 @@ struct ImplicitOptions {
   bool matrixFree = true;  // cg: products through the spring kernels, not the sparse matrix
   // The converged integrators (implicit, midpoint, newmark, bdf2;
   // solvers/methods/newton_integrators.h).
-  int newtonMaxIterations = 30;           // a step still unconverged then is counted, reported
+  int newtonMaxIterations = 30;  // then the step is retried as two half steps
+  // A step Newton leaves unconverged is retried as two half steps, each of them so again, down
+  // to h / 2^newtonHalvings; a sub-step still unconverged there is accepted, counted, reported.
+  int newtonHalvings = 4;
   double newtonTolerance = 1e-8;          // relative residual that ends the iterations
   double newtonPositionTolerance = 1e-8;  // m: a full Newton update this small ends them too
   int lineSearchMaxCuts = 12;  // halvings of the Newton update; none descends: the whole step

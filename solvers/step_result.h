@@ -14,8 +14,17 @@ struct [[nodiscard]] StepResult {
   // Not a failure of the numerics either: a resource the step needs is missing (the
   // address-space limit leaves the BLAS no room); the state is left as it was before the step.
   bool resource = false;
+  // A success whose equations were not solved to the integrator's tolerance (Newton at its
+  // iteration cap after every retry): accepted and counted; callers that must not accept it
+  // (jello-sim --strict) stop here.
+  bool unconverged = false;
 
   static StepResult success() { return {}; }
+  static StepResult unconvergedSuccess() {
+    StepResult r;
+    r.unconverged = true;
+    return r;
+  }
   static StepResult failure(std::string why) { return {false, std::move(why), false}; }
   static StepResult interruption() { return {false, "interrupted", true}; }
   static StepResult resourceFailure(std::string why) {

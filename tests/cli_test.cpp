@@ -134,13 +134,15 @@ TEST(JelloSim, ImplicitIntegratorsRunTheStiffSceneThatExplicitOnesCannot) {
             0);
   EXPECT_EQ(nlohmann::json::parse(test::readFile(stats))["solver"]["factorizations"], 10);
 
-  // A Newton cap too low to converge: the run goes on, counts and says so.
+  // A Newton cap too low to converge, and no retries: the run goes on, counts and says so.
   const Outcome capped = run(sim() + " " + stiff.string() +
                              " --integrator midpoint --dt 0.01 --time 0.05 -q --newton-iters 1 "
-                             "--newton-tol 1e-14 --stats " +
+                             "--newton-tol 1e-14 --newton-halvings 0 --stats " +
                              stats.string());
   ASSERT_EQ(capped.code, 0) << capped.output;
-  EXPECT_TRUE(contains(capped.output, "did not converge within 1 Newton iterations"))
+  EXPECT_TRUE(contains(capped.output,
+                       "5 of 5 steps taken were accepted unconverged: Newton did "
+                       "not converge within 1 iterations"))
       << capped.output;
   EXPECT_EQ(nlohmann::json::parse(test::readFile(stats))["solver"]["newton_unconverged_steps"], 5);
 
@@ -481,6 +483,46 @@ TEST(Contact, FlagsChooseTheModelInBothToolsAndBadOnesAreRefused) {
 // #16: --stats /dev/stdout works (the link is followed to the pipe and written in place), and
 // --out to a device leaves the device a device. Private stand-ins, never the machine's own
 // /dev/stdout or /dev/null: a writer that regressed would replace them.
+// A step Newton cannot converge even in halves is accepted, counted and said; --strict stops
+// the run there with exit 4, naming the step, and writes no world.
+TEST(JelloSim, UnconvergedStepsAreCountedAndStrictMakesThemAnError) {
+  test::TempDir dir;
+  const auto out = dir.path() / "out.w", stats = dir.path() / "s.json";
+  const std::string starved = sim() + " " + world("jello.w") +
+                              " --integrator implicit --steps 3 --newton-iters 1 --newton-tol "
+                              "1e-14 --newton-xtol 1e-300 --newton-halvings 1 --stats " +
+                              stats.string() + " --out " + out.string();
+  const Outcome lenient = run(starved + " --quiet");
+  EXPECT_EQ(lenient.code, 0) << lenient.output;
+  EXPECT_TRUE(contains(lenient.output, "3 of 3 steps taken were accepted unconverged"))
+      << lenient.output;
+  EXPECT_TRUE(std::filesystem::exists(out));
+  {
+    std::ifstream in(stats);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["solver"]["newton_unconverged_steps"].get<double>(), 3.0);
+    EXPECT_EQ(j["solver"]["newton_retried_steps"].get<double>(), 3.0);  // one halving each
+    EXPECT_EQ(j["steps"].get<long>(), 3);
+  }
+  std::filesystem::remove(out);
+  const Outcome strict = run(starved + " --quiet --strict");
+  EXPECT_EQ(strict.code, 4) << strict.output;
+  EXPECT_TRUE(contains(strict.output,
+                       "step 1 (to t = 0.0005 s, integrator implicit) did not "
+                       "converge within 1 Newton iterations, even as 2 sub-steps"))
+      << strict.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  std::ifstream in(stats);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["steps"].get<long>(), 1);
+  EXPECT_TRUE(j.contains("unconverged"));
+  // Converged runs are not touched by --strict.
+  EXPECT_EQ(
+      run(sim() + " " + world("jello.w") + " --integrator implicit --steps 3 --quiet --strict")
+          .code,
+      0);
+}
+
 TEST(JelloSim, WritesStatsToDevStdoutAndLeavesADeviceADevice) {
   test::TempDir dir;
   const auto stdoutLink = dir.path() / "stdout";

@@ -244,6 +244,8 @@ void Panel::solverOptions(const Frame& frame, SimRunner& runner) {
       }
       ImGui::SliderInt("newton iters", &o.implicit.newtonMaxIterations, 1, 100);
       changed |= released();
+      ImGui::SliderInt("newton halvings", &o.implicit.newtonHalvings, 0, 8);
+      changed |= released();
       changed |= ImGui::Checkbox("keep factor", &o.implicit.reuseFactor);
       ImGui::SliderInt("seed iterations", &o.implicit.seedIterations, 0, 100);
       changed |= released();

@@ -1,8 +1,8 @@
 // jello-sim: steps a world headless and reports what happened.
 //   jello-sim WORLD [--integrator NAME] [--dt S] [--time S | --steps N] [--cube N]
-//             [--out FILE.w] [--trace FILE.csv --every K] [--stats FILE.json] [--quiet]
+//             [--out FILE.w] [--trace FILE.csv --every K] [--stats FILE.json] [--quiet] [--strict]
 // Exit codes: 0 done, 1 bad input, an I/O failure or a step that cannot run here (a memory limit),
-// 2 bad usage, 3 the simulation diverged,
+// 2 bad usage, 3 the simulation diverged, 4 a step left unconverged under --strict,
 // 128 + signal when interrupted by SIGINT, SIGTERM or SIGHUP (it stops at a step boundary).
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -40,6 +40,7 @@ using jello::Simulation;
 constexpr int kExitInput = 1;
 constexpr int kExitUsage = 2;
 constexpr int kExitDiverged = 3;
+constexpr int kExitUnconverged = 4;
 
 volatile std::sig_atomic_t interruptSignal = 0;
 
@@ -59,6 +60,7 @@ struct Options {
   bool outGiven = false, traceGiven = false, statsGiven = false;  // even as an empty string
   long every = 100;
   bool quiet = false;
+  bool strict = false;          // an unconverged step stops the run (exit 4)
   jello::SolverOptions solver;  // from the solver flags (solver_flags.h)
   jello::ContactFlags contact;  // over the file's (contact_flags.h)
   jello::ReaderLimits limits;
@@ -114,8 +116,9 @@ struct Outcome {
   long done = 0;   // steps taken (a diverged step not counted)
   double wall = 0.0;
   bool diverged = false;
-  int interrupted = 0;  // the signal that stopped it
-  std::string failure;  // a step that could not run (a resource limit), not a divergence
+  int interrupted = 0;      // the signal that stopped it
+  std::string failure;      // a step that could not run (a resource limit), not a divergence
+  std::string unconverged;  // --strict: the step accepted unconverged that stopped the run
   jello::Energy start, end;
   jello::Vec3 startL, endL;
 };
@@ -178,6 +181,14 @@ void stepAll(Simulation& sim, const Options& opt, Trace& trace, Outcome& o) {
       if (r.resource) o.failure = r.message;
       o.diverged = !r.interrupted && !r.resource;  // both leave the state at the step's start
       break;
+    } else if (r.unconverged && opt.strict) {
+      std::ostringstream os;
+      os << "step " << sim.steps() << " (to t = " << sim.state().t << " s, integrator " << name
+         << ") did not converge within " << opt.solver.implicit.newtonMaxIterations
+         << " Newton iterations, even as " << (1 << opt.solver.implicit.newtonHalvings)
+         << " sub-steps (--strict)";
+      o.unconverged = os.str();
+      break;
     }
     if (sim.steps() % opt.every == 0) trace.row(sim);
     progress.update(i + 1, o.total);
@@ -186,7 +197,7 @@ void stepAll(Simulation& sim, const Options& opt, Trace& trace, Outcome& o) {
   for (int signo : {SIGINT, SIGTERM, SIGHUP}) jello::setSignalHandler("jello-sim", signo, SIG_DFL);
   o.interrupted = interruptSignal;
   progress.finish();
-  o.done = o.diverged ? sim.steps() - 1 : sim.steps();
+  o.done = o.diverged ? sim.steps() - 1 : sim.steps();  // an unconverged step was taken
   o.end = sim.model().energy(sim.state());
   o.endL = sim.model().angularMomentum(sim.state());
 }
@@ -218,13 +229,17 @@ nlohmann::json statistics(const Options& opt, const Simulation& sim, const Outco
   };
   for (const jello::Statistic& st : sim.integrator().statistics()) {
     stats["solver"][st.name] = st.value;
-    if (st.name == "newton_unconverged_steps" && st.value > 0) {
+    if (st.name == "newton_unconverged_steps" && st.value > 0 && o.unconverged.empty()) {
+      const int halvings = opt.solver.implicit.newtonHalvings;
+      const std::string retried =
+          halvings > 0 ? ", even in sub-steps of 1/" + std::to_string(1 << halvings) : "";
       std::fprintf(stderr,
-                   "jello-sim: warning: %.0f of %ld steps did not converge within %d Newton "
-                   "iterations (raise --newton-iters or --newton-tol; but where a point meets a "
-                   "wall or an obstacle at speed the contact's damping force jumps and the "
-                   "step's equations may have no root: solvers/README.md, \"implicit\")\n",
-                   st.value, o.done, opt.solver.implicit.newtonMaxIterations);
+                   "jello-sim: warning: %.0f of %ld steps taken were accepted unconverged: Newton "
+                   "did not converge within %d iterations%s (raise --newton-iters or "
+                   "--newton-halvings; --strict makes this an error; where a point meets a wall "
+                   "at speed the penalty's damping force jumps and the step's equations may have "
+                   "no root: --contact smooth; solvers/README.md, \"implicit\")\n",
+                   st.value, sim.steps(), opt.solver.implicit.newtonMaxIterations, retried.c_str());
     }
   }
   if (o.interrupted) {
@@ -234,6 +249,10 @@ nlohmann::json statistics(const Options& opt, const Simulation& sim, const Outco
   if (!o.failure.empty()) {
     stats["failure"] = o.failure;
     std::fprintf(stderr, "jello-sim: error: %s\n", o.failure.c_str());
+  }
+  if (!o.unconverged.empty()) {
+    stats["unconverged"] = o.unconverged;
+    std::fprintf(stderr, "jello-sim: error: %s\n", o.unconverged.c_str());
   }
   if (o.diverged) {
     const jello::Divergence& d = *sim.divergence();
@@ -250,10 +269,11 @@ void printSummary(const Options& opt, const Simulation& sim, const Outcome& o) {
               sim.model().springs().numSprings());
   std::printf("integrator   %s, dt = %g s\n", name.c_str(), sim.dt());
   std::printf("steps        %ld%s\n", o.done,
-              o.diverged           ? " (then diverged)"
-              : o.interrupted      ? " (interrupted)"
-              : !o.failure.empty() ? " (then stopped: see the error above)"
-                                   : "");
+              o.diverged      ? " (then diverged)"
+              : o.interrupted ? " (interrupted)"
+              : !o.failure.empty() || !o.unconverged.empty()
+                  ? " (then stopped: see the error above)"
+                  : "");
   std::printf("simulated    %.6g s\n", s.t);
   std::printf("wall time    %.3f s (%.0f steps/s, %.2fx real time)\n", o.wall,
               o.wall > 0 ? double(o.done) / o.wall : 0.0, o.wall > 0 ? s.t / o.wall : 0.0);
@@ -282,7 +302,7 @@ bool writeOutputs(const Options& opt, const Simulation& sim, const Outcome& o, c
       writeFailed = true;
     }
   };
-  const bool complete = !o.diverged && !o.interrupted && o.failure.empty();
+  const bool complete = !o.diverged && !o.interrupted && o.failure.empty() && o.unconverged.empty();
   if (!opt.trace.empty()) attempt([&] { jello::writeFileAtomically(opt.trace, trace.text()); });
   if (!opt.stats.empty()) {
     attempt([&] { jello::writeFileAtomically(opt.stats, stats.dump(2) + "\n"); });
@@ -292,9 +312,10 @@ bool writeOutputs(const Options& opt, const Simulation& sim, const Outcome& o, c
   if (writeFailed) return false;
   if (!complete && !opt.out.empty()) {
     std::fprintf(stderr, "jello-sim: %s not written (the simulation %s)\n", opt.out.c_str(),
-                 o.diverged      ? "diverged"
-                 : o.interrupted ? "was interrupted"
-                                 : "could not go on");
+                 o.diverged               ? "diverged"
+                 : o.interrupted          ? "was interrupted"
+                 : !o.unconverged.empty() ? "stopped at an unconverged step"
+                                          : "could not go on");
   }
   return true;
 }
@@ -343,6 +364,7 @@ int run(const Options& opt) {
   if (!writeOutputs(opt, sim, o, trace, stats)) return kExitInput;
   if (!o.failure.empty()) return kExitInput;
   if (o.interrupted) return 128 + o.interrupted;
+  if (!o.unconverged.empty()) return kExitUnconverged;
   return o.diverged ? kExitDiverged : 0;
 }
 
@@ -353,7 +375,7 @@ std::optional<int> parseCommandLine(int argc, char** argv, Options& opt) {
       "steps/s, real-time factor, energy at start and end, and the solver's statistics. For "
       "cvode, --dt is the output interval; CVODE chooses its own internal steps.\n"
       "Exit codes: 0 done, 1 bad world file, I/O failure or a memory limit too tight, 2 bad usage, "
-      "3 diverged, "
+      "3 diverged, 4 a step left unconverged with --strict, "
       "128+N interrupted by signal N (Ctrl-C: 130; trace and stats are written, --out is not).",
       "jello-sim"};
   app.add_option("world", opt.world, "World file (.w)")->required();
@@ -376,6 +398,10 @@ std::optional<int> parseCommandLine(int argc, char** argv, Options& opt) {
       ->needs(trace);
   app.add_option("--stats", opt.stats, "Write the summary as JSON");
   app.add_flag("--quiet,-q", opt.quiet, "Print nothing but errors");
+  app.add_flag("--strict", opt.strict,
+               "Stop with exit code 4 at the first step Newton leaves unconverged, even after "
+               "its retries in half steps (without it, such steps are accepted, counted and "
+               "reported)");
   app.add_option("--max-field-resolution", opt.limits.maxFieldResolution,
                  "Refuse worlds with a larger force field (nodes per axis)")
       ->check(jello::cli::range(2, 1024))

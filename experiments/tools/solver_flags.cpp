@@ -67,8 +67,13 @@ void addSolverFlags(CLI::App& app, SolverFlags& f) {
   option("--newton-iters", implicit.newtonMaxIterations,
          newton +
              "most Newton iterations per step (a step "
-             "still unconverged is counted and reported)")
+             "still unconverged is retried as two half steps)")
       ->check(cli::range(1, 1000));
+  option("--newton-halvings", implicit.newtonHalvings,
+         newton +
+             "an unconverged step is retried as two half steps, down to h / 2^N; a sub-step "
+             "still unconverged there is accepted, counted and reported (0: no retries)")
+      ->check(cli::range(0, 20));
   option("--newton-tol", implicit.newtonTolerance,
          newton + "relative residual that ends the iterations")
       ->check(cli::positive());

@@ -45,6 +45,7 @@ StepResult LinearizedBackwardEuler::step(const Model& model, State& s, double h)
     maxIterations = options_.contactNewtonIterations;
     ++contactSteps_;
   }
+  bool unconverged = false;  // the contact onset's Newton stopped at its cap
   if (maxIterations > 1) {
     // Newton on g(v1): (M - h D - h^2 K)(x1, v1) delta = -g.
     for (;;) {
@@ -52,6 +53,7 @@ StepResult LinearizedBackwardEuler::step(const Model& model, State& s, double h)
       if (lastResidual_ <= tolerance) break;
       if (iterations >= maxIterations) {
         ++unconverged_;
+        unconverged = true;
         break;
       }
       rhs_ = -g_;
@@ -69,7 +71,7 @@ StepResult LinearizedBackwardEuler::step(const Model& model, State& s, double h)
   s.x = x1_;  // copied, not swapped: the state's storage stays put (Integrator::step)
   s.v = v1_;
   s.t += h;
-  return StepResult::success();
+  return unconverged ? StepResult::unconvergedSuccess() : StepResult::success();
 }
 
 std::vector<Statistic> LinearizedBackwardEuler::statistics() const {

@@ -127,10 +127,54 @@ StepResult NewtonIntegrator::seed(const Model& model, double inertia, double h) 
   return StepResult::success();
 }
 
-// Long: one step's Newton loop (seeds, factor reuse, line search, stopping tests) read top to
-// bottom.
 StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
   bind(model);
+  stepUnconverged_ = false;
+  int iterations = 0;
+  StepResult res = advance(model, s, h, 0, iterations);
+  lastIterations_ = iterations;
+  lastConverged_ = !stepUnconverged_;
+  iterations_ += iterations;
+  maxIterations_ = std::max<long>(maxIterations_, iterations);
+  ++steps_;
+  if (!res.ok) return res;
+  if (stepUnconverged_) {
+    ++unconverged_;
+    return StepResult::unconvergedSuccess();
+  }
+  return res;
+}
+
+// One step of h from s by Newton; unconverged, two half steps instead, down to the floor of
+// options_.newtonHalvings halvings, where an unconverged sub-step is accepted and flagged.
+StepResult NewtonIntegrator::advance(const Model& model, State& s, double h, int depth,
+                                     int& iterations) {
+  bool converged = false;
+  if (StepResult res = solve(model, s, h, converged, iterations); !res.ok) return res;
+  if (converged || depth >= options_.newtonHalvings) {
+    if (!converged) stepUnconverged_ = true;
+    s.v = form_.sigmaNew * d_ + form_.vNewConst;
+    s.x += d_;
+    s.t += h;
+    accepted(s, h);
+    return StepResult::success();
+  }
+  ++retries_;
+  // A failure or a stop inside the halves leaves s where this step started (Integrator::step).
+  State start = s;
+  for (int half = 0; half < 2; ++half) {
+    if (StepResult res = advance(model, s, 0.5 * h, depth + 1, iterations); !res.ok) {
+      s = std::move(start);
+      return res;
+    }
+  }
+  return StepResult::success();
+}
+
+// Long: one Newton solve (seeds, factor reuse, line search, stopping tests) read top to bottom.
+// Leaves the displacement in d_ and the form in form_; s is not changed.
+StepResult NewtonIntegrator::solve(const Model& model, const State& s, double h, bool& converged,
+                                   int& iterations) {
   this->form(model, s, h, form_);
   const ImplicitStepForm& form = form_;
   const double inertia = form.gamma / (h * h);  // r = gamma m/h^2 (d - d_pred) - f
@@ -140,8 +184,8 @@ StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
   if (options_.seedIterations > 0) {
     if (StepResult res = seed(model, inertia, h); !res.ok) return res;
   }
-  int iterations = 0;
-  bool converged = false;
+  converged = false;
+  int k = 0;  // this solve's iterations; `iterations` sums the step's, retries included
   double previousNorm = std::numeric_limits<double>::infinity();
   for (;;) {
     evaluate(model, inertia, d_);
@@ -149,8 +193,9 @@ StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
       converged = true;
       break;
     }
-    if (iterations >= options_.newtonMaxIterations) break;
+    if (k >= options_.newtonMaxIterations) break;
     if (interruptRequested()) return StepResult::interruption();  // s is still the start
+    ++k;
     ++iterations;
     // Newton: (h^2/gamma) J delta = -(h^2/gamma) r. x_e, v_e are those of d_ (evaluate).
     rhs_ = (-h * h / form.gamma) * r_;
@@ -207,17 +252,6 @@ StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
     }
     d_ += alpha * delta_;
   }
-  lastIterations_ = iterations;
-  lastConverged_ = converged;
-  iterations_ += iterations;
-  maxIterations_ = std::max<long>(maxIterations_, iterations);
-  if (!converged) ++unconverged_;
-  ++steps_;
-
-  s.v = form.sigmaNew * d_ + form.vNewConst;
-  s.x += d_;
-  s.t += h;
-  accepted(s, h);
   return StepResult::success();
 }
 
@@ -247,6 +281,7 @@ std::vector<Statistic> NewtonIntegrator::statistics() const {
       {"newton_iterations_per_step", steps_ ? double(iterations_) / double(steps_) : 0.0},
       {"newton_iterations_max", static_cast<double>(maxIterations_)},
       {"newton_unconverged_steps", static_cast<double>(unconverged_)},
+      {"newton_retried_steps", static_cast<double>(retries_)},
       {"line_search_cuts", static_cast<double>(cuts_)},
       {"line_search_failures", static_cast<double>(searchFailures_)},
       {"factor_reuses", static_cast<double>(reuses_)},

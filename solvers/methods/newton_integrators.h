@@ -40,7 +40,10 @@
 // + |f|, or when a Newton update moves no coordinate more than newtonPositionTolerance (m), the
 // update then taken whole: the absolute floor that ends the iterations at rest, where round-off
 // keeps the relative test from being met. A step
-// that reaches newtonMaxIterations is accepted, counted and reported, never silent.
+// that reaches newtonMaxIterations is retried as two half steps of h/2 (each retried so in turn,
+// down to h / 2^newtonHalvings: a contact whose onset the full step jumped over is met by the
+// halves); a sub-step still unconverged at that floor is accepted, counted, and the step returns
+// StepResult::unconverged, never silent. bdf2's halves are started by backward Euler (another h).
 // Optionally (seedIterations) Newton starts where a few iterations with the constant projective
 // matrix P = M + L(a c + b k) left the inertial guess: for backward Euler these are projective
 // dynamics' iterations (solvers/methods/projective_integrator.h), for every method a descent that
@@ -75,11 +78,12 @@ class NewtonIntegrator : public Integrator {
   StepResult step(const Model& model, State& state, double h) override;
   std::vector<Statistic> statistics() const override;
 
-  // The last step's Newton iterations and final relative residual.
+  // The last step's Newton iterations (its retries' included) and final relative residual.
   int lastIterations() const { return lastIterations_; }
   double lastResidual() const { return lastResidual_; }
   bool lastConverged() const { return lastConverged_; }
   long unconvergedSteps() const { return unconverged_; }
+  long retriedSteps() const { return retries_; }  // (sub-)steps retried as two halves
   const SpdSolver& linearSolver() const { return system_.solver(); }
 
   // The step's residual r(y) (N) and Newton matrix J = dr/dy (N/m) at y from `start`, for
@@ -106,6 +110,10 @@ class NewtonIntegrator : public Integrator {
   // options_.seedIterations projective iterations on d_ (ImplicitOptions::seedIterations).
   StepResult seed(const Model& model, double inertia, double h);
   std::pair<double, double> matrixCoefficients(double h) const;
+  // A step of h, retried as two halves while unconverged (see above); depth halvings so far.
+  StepResult advance(const Model& model, State& s, double h, int depth, int& iterations);
+  // Newton's iterations for a step of h from s into d_ and form_; s unchanged.
+  StepResult solve(const Model& model, const State& s, double h, bool& converged, int& iterations);
 
   ImplicitOptions options_;
   ImplicitSystem system_;
@@ -120,7 +128,8 @@ class NewtonIntegrator : public Integrator {
   double lastResidual_ = 0.0;
   bool lastConverged_ = true;
   long steps_ = 0, iterations_ = 0, maxIterations_ = 0, cuts_ = 0, searchFailures_ = 0,
-       unconverged_ = 0, reuses_ = 0, seeds_ = 0;
+       unconverged_ = 0, retries_ = 0, reuses_ = 0, seeds_ = 0;
+  bool stepUnconverged_ = false;  // a sub-step of the current step was accepted unconverged
   ChebyshevWeights seedWeights_;  // the seed iterations' (ImplicitOptions::seedChebyshevRho)
 };
 

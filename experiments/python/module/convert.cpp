@@ -139,8 +139,8 @@ void translateExceptions(std::exception_ptr p) {
 
 // The keywords mirror jello-sim's flags with '_' for '-' (experiments/python/README.md).
 constexpr const char* kSolverOptionNames =
-    "linear_solver, preconditioner, matrix_free, clamp, cg_tol, newton_iters, newton_tol, "
-    "newton_xtol, factor_reuse, newton_seed, newton_seed_tol, newton_seed_chebyshev, "
+    "linear_solver, preconditioner, matrix_free, clamp, cg_tol, newton_iters, newton_halvings, "
+    "newton_tol, newton_xtol, factor_reuse, newton_seed, newton_seed_tol, newton_seed_chebyshev, "
     "refactor_ratio, projective_iters, projective_tol, projective_chebyshev, rtol, cvode_method, "
     "cvode_krylov, atol, "
     "atol_x, atol_v, contact_roots, max_order, stab_lim_det, max_step";
@@ -195,6 +195,8 @@ jello::SolverOptions solverOptionsFrom(const py::kwargs& kwargs, jello::SolverOp
       o.implicit.cgTolerance = o.cvode.cgTolerance = positive(real(), n);
     } else if (name == "newton_iters") {
       o.implicit.newtonMaxIterations = int(inRange(as<long>(value, name), 1, 1000, n));
+    } else if (name == "newton_halvings") {
+      o.implicit.newtonHalvings = int(inRange(as<long>(value, name), 0, 20, n));
     } else if (name == "newton_tol") {
       o.implicit.newtonTolerance = positive(real(), n);
     } else if (name == "newton_xtol") {
