@@ -6,7 +6,8 @@ world, kElastic 2e4 N/m at dt = 0.01 s, written by jello-create-world; worlds/sh
 every integrator that ends its steps in Newton's iterations, with each contact model of
 src/world/contact_law.h (`--contact`, the smooth one at its default layer), and writes
 experiments/results/contact_models.json: per run the steps, the steps left unconverged at the
-Newton cap after the retries in half steps, the (sub-)steps retried, Newton iterations per step and the energy at the start and the end. The README's
+Newton cap after the retries in half steps, the (sub-)steps retried, Newton iterations per step,
+the least signed distance of any point to a solid over the run and the energy at the start and the end. The README's
 contact table (scripts/results-tables.py, block contact-newton) is made from that file alone.
 
     scripts/contact-table.py [--bin build/native/bin]
@@ -50,6 +51,8 @@ def run(bin_dir, world, steps, integrator, model, tmp):
     proc = subprocess.run([os.path.join(bin_dir, "jello-sim"), world, "--integrator", integrator,
                            "--contact", model, "--steps", str(steps), "--quiet",
                            "--stats", stats], capture_output=True, text=True)
+    if proc.returncode == 1 and "barrier contact model needs" in proc.stderr:
+        return {"refused": proc.stderr.strip().split(": ", 2)[-1]}
     if proc.returncode not in (0, 3):
         raise SystemExit(f"contact-table: jello-sim failed ({proc.returncode}): {proc.stderr}")
     with open(stats) as f:
@@ -61,7 +64,9 @@ def run(bin_dir, world, steps, integrator, model, tmp):
             "newton_per_step": solver.get("newton_iterations_per_step", 0.0),
             "energy_start_J": s["energy_start"]["total_J"],
             "energy_end_J": s["energy_end"]["total_J"],
-            "contact_layer_m": s["contact"]["layer_m"]}
+            "contact_layer_m": s["contact"]["layer_m"],
+            "dhat_m": s["contact"]["dhat_m"], "kappa_N_per_m": s["contact"]["kappa_N_per_m"],
+            "min_obstacle_distance_m": s["min_obstacle_distance_m"]}
 
 
 def main():

@@ -612,6 +612,16 @@ def ci_time():
             f"the stages over half a minute: {stages} minutes.")
 
 
+def contact_cell(r):
+    """One run of the contact table: unconverged (retried), Newton/step, least distance."""
+    if "refused" in r:
+        return "refused: a solid without an exterior distance"
+    least = r["min_obstacle_distance_m"]
+    cell = (f"{r['unconverged_steps']} of {r['steps']} ({r['retried_steps']}), "
+            f"{r['newton_per_step']:.1f}, {least * 1000:+.3g}")
+    return cell + (" (diverged)" if r["diverged"] else "")
+
+
 def contact_newton():
     """Newton's unconverged steps per scene, integrator and contact model (scripts/contact-table.py)."""
     path = os.path.join(RESULTS, "contact_models.json")
@@ -621,22 +631,21 @@ def contact_newton():
         data = json.load(f)
     runs = data["runs"]
     models = list(dict.fromkeys(r["contact"] for r in runs))
-    head = "| scene | integrator | " + " | ".join(
-        f"{m}: unconverged (retried), Newton/step" for m in models) + " |"
+    head = "| scene | integrator | " + " | ".join(models) + " |"
     lines = [head, "|---|---|" + "---|" * len(models)]
     cells = {}
     for r in runs:
         cells.setdefault((r["scene"], r["integrator"]), {})[r["contact"]] = r
     for (scene, integrator), by_model in cells.items():
-        row = [f"{r['unconverged_steps']} of {r['steps']} ({r['retried_steps']}), "
-               f"{r['newton_per_step']:.1f}"
-               + (" (diverged)" if r["diverged"] else "")
-               for r in (by_model[m] for m in models)]
+        row = [contact_cell(by_model[m]) for m in models]
         lines.append(f"| {scene} | `{integrator}` | " + " | ".join(row) + " |")
     layer = next(r["contact_layer_m"] for r in runs if r["contact"] == "smooth")
+    dhat = next(r["dhat_m"] for r in runs if r["contact"] == "barrier" and "dhat_m" in r)
     lines.append("")
-    lines.append(f"The smooth model at its default layer, {layer * 1000:g} mm "
-                 f"({data['date_utc'][:10]}, commit {data['commit'][:7]}).")
+    lines.append(f"Each cell: unconverged of steps (retried), Newton iterations per step, least "
+                 f"distance to a solid in mm. The smooth model at its default layer, "
+                 f"{layer * 1000:g} mm; the barrier at dhat {dhat * 1000:g} mm, kappa = "
+                 f"kCollision ({data['date_utc'][:10]}, commit {data['commit'][:7]}).")
     return "\n".join(lines)
 
 

@@ -107,6 +107,10 @@ StepResult Simulation::step() {
   if (!verified_) {  // else the last step's divergence check saw it finite
     JELLO_VALIDATE(std::isfinite(state_.x.sum() + state_.v.sum()),
                    "the state handed to a step is finite");
+    // A barrier scene must start outside every solid (callers say so before stepping).
+    if (std::string why = model_.contactError(state_.x.data()); !why.empty()) {
+      return StepResult::failure(why);
+    }
     verified_ = true;
   }
   // previous_ = state_, and below the divergence check, on the threads the model splits its
@@ -154,6 +158,11 @@ StepResult Simulation::step() {
     });
     for (int t = 1; t < blocks.threads; ++t) parts[0].add(parts[static_cast<std::size_t>(t)]);
     broken = describeDivergence(parts[0], kDivergenceBound, speedBound);
+    if (broken && model_.barrierContact()) {
+      *broken +=
+          " (barrier contact: forces are infinite inside a solid; an explicit step must "
+          "not carry a point across the barrier's layer dhat: src/PHYSICS.md)";
+    }
   } else {
     broken = result.message;
   }
@@ -166,10 +175,33 @@ StepResult Simulation::step() {
       broken = energyGrowth();
     }
   }
+  if (!broken) broken = obstacleDistance();
   if (!broken) return result;
   state_ = previous_;
   divergence_ = Divergence{state_.t, steps_, integrator_->kind(), *broken};
   return StepResult::failure(divergence_->describe());
+}
+
+std::optional<std::string> Simulation::obstacleDistance() {
+  if (!trackDistance_ && !model_.barrierContact()) return std::nullopt;
+  const double d = model_.minObstacleDistance(state_.x.data());
+  if (model_.barrierContact() && !(d > 0.0)) {
+    std::ostringstream os;
+    os << "a point reached a solid through the barrier (distance " << d << " m)";
+    return os.str();
+  }
+  minDistance_ = std::min(minDistance_, d);
+  return std::nullopt;
+}
+
+void Simulation::trackObstacleDistance() {
+  trackDistance_ = true;
+  minDistance_ = model_.minObstacleDistance(state_.x.data());
+}
+
+std::optional<double> Simulation::minObstacleDistance() const {
+  if (!trackDistance_ || !std::isfinite(minDistance_)) return std::nullopt;
+  return minDistance_;
 }
 
 void Simulation::setIntegrator(IntegratorKind kind) {

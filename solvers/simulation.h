@@ -100,6 +100,12 @@ class Simulation {
   // The world with the current state as its initial state (what --out saves).
   World currentWorld() const;
 
+  // Keep the least signed distance of any point to any solid (Model::minObstacleDistance) over
+  // the states from now on, the current one included: negative, the deepest penetration.
+  void trackObstacleDistance();
+  // That least distance (m), or nothing when not tracked or the scene has no solid.
+  std::optional<double> minObstacleDistance() const;
+
  private:
   World world_;
   Model model_;
@@ -118,8 +124,12 @@ class Simulation {
   long envelopeStart_ = 0;
   double fieldWork_ = 0.0;
   double userWork_ = 0.0;
+  bool trackDistance_ = false;
+  double minDistance_ = 0.0;
   double externalWork() const { return fieldWork_ + userWork_; }
   std::optional<std::string> energyGrowth();
+  // The barrier's rule (no point at or inside a solid) and the tracked least distance.
+  std::optional<std::string> obstacleDistance();
   double energyBudget() const;
 };
 

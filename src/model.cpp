@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <string>
 
 #include "src/base/assertions.h"
 
@@ -13,7 +15,8 @@ ModelSpec modelSpecFromWorld(const World& world) {
   spec.numPoints = lattice.numPoints();
   spec.mass = world.mass;
   spec.springs = latticeSpringGroups(lattice, world.kElastic, world.dElastic);
-  spec.contact = {world.kCollision, world.dCollision, world.contact.model, world.contact.layer};
+  spec.contact = {world.kCollision,    world.dCollision,   world.contact.model,
+                  world.contact.layer, world.contact.dhat, world.contact.kappa};
   spec.plane = world.plane;
   spec.sphere = world.sphere;
   spec.cone = world.cone;
@@ -167,11 +170,61 @@ bool Model::contactBegins(const double* x0, const double* x1) const {
 
 bool Model::inContact(const double* x) const {
   for (const auto& o : obstacles_) {
+    const double reach = o->reach();
     for (int p = 0; p < n_; ++p) {
-      if (o->depth(pointAt(x, n_, p)) > 0.0) return true;
+      const Vec3 xp = pointAt(x, n_, p);
+      if (o->depth(xp) > 0.0 || (reach > 0.0 && o->signedDistance(xp) < reach)) return true;
     }
   }
   return false;
+}
+
+bool Model::barrierContact() const {
+  for (const auto& o : obstacles_) {
+    if (o->constants().model == ContactModel::Barrier) return true;
+  }
+  return false;
+}
+
+double Model::minObstacleDistance(const double* x) const {
+  double least = std::numeric_limits<double>::infinity();
+  for (const auto& o : obstacles_) {
+    for (int p = 0; p < n_; ++p) least = std::min(least, o->signedDistance(pointAt(x, n_, p)));
+  }
+  return least;
+}
+
+double Model::contactStepBound(const double* x, const double* dx) const {
+  double bound = 1.0;
+  for (const auto& o : obstacles_) {
+    for (int p = 0; p < n_; ++p) {
+      const Vec3 xp = pointAt(x, n_, p), dp = pointAt(dx, n_, p);
+      // A point farther from the solid than it moves cannot reach it (the distance is
+      // 1-Lipschitz): the cheap test first.
+      if (o->signedDistance(xp) > norm(dp)) continue;
+      bound = std::min(bound, o->stepBound(xp, dp));
+    }
+  }
+  return bound;
+}
+
+std::string Model::contactError(const double* x) const {
+  if (!barrierContact()) return "";
+  for (const auto& o : obstacles_) {
+    if (!o->hasExteriorDistance()) {
+      return "the barrier contact model needs each solid's distance outside it, which the " +
+             std::string(obstacleName(o->kind())) + " does not have yet (use penalty or smooth)";
+    }
+    for (int p = 0; p < n_; ++p) {
+      const double d = o->signedDistance(pointAt(x, n_, p));
+      if (!(d > 0.0)) {
+        return "the barrier contact model needs every point outside every solid, but point " +
+               std::to_string(p) + " is " + (d < 0.0 ? "inside" : "on the surface of") + " the " +
+               std::string(obstacleName(o->kind())) + " (" + std::to_string(-d) + " m deep)";
+      }
+    }
+  }
+  return "";
 }
 
 double Model::userForceWork(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1) const {

@@ -12,6 +12,7 @@
 #include <atomic>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "src/base/parallel.h"
@@ -96,8 +97,20 @@ class Model {
   // True when some point is in contact with some obstacle at positions x1 but was not at x0:
   // the contact set changed between them.
   bool contactBegins(const double* x0, const double* x1) const;
-  // True when some point is in contact with some obstacle at positions x.
+  // True when some point is in contact with some obstacle at positions x (for the barrier:
+  // within its reach dhat).
   bool inContact(const double* x) const;
+  // True when contact is the barrier (src/world/contact_law.h): no point may reach a solid.
+  bool barrierContact() const;
+  // The least signed distance (m) of any point to any solid at positions x: < 0 when one is
+  // inside (Obstacle::signedDistance); +inf without solids.
+  double minObstacleDistance(const double* x) const;
+  // The largest s in [0, 1] for which no point moving from x along s dx (3n each) reaches a
+  // solid (Obstacle::stepBound): the barrier's line-search bound.
+  double contactStepBound(const double* x, const double* dx) const;
+  // Why this model cannot step from positions x, or empty: the barrier needs every solid's
+  // exterior distance and every point outside every solid.
+  std::string contactError(const double* x) const;
 
   // Work (J) the force field does on the points moving from x0 to x1 (3n each), by the
   // trapezoid rule along the straight path: sum of 1/2 (F(x0) + F(x1)) . (x1 - x0). Exact for

@@ -478,6 +478,43 @@ TEST(Contact, FlagsChooseTheModelInBothToolsAndBadOnesAreRefused) {
   EXPECT_EQ(wrong.code, 2);
   EXPECT_TRUE(contains(wrong.output, "applies to the smooth contact model only")) << wrong.output;
   EXPECT_EQ(run(sim() + " " + world("jello.w") + " --steps 1 --contact bogus").code, 2);
+
+  // The barrier: --dhat and --kappa (kappa defaults to the world's kCollision), only with it.
+  ASSERT_EQ(run(create() + " -o " + out.string() + " --contact barrier --dhat 0.003").code, 0);
+  EXPECT_EQ(readWorld(out).contact, (ContactLaw{ContactModel::Barrier, 0.0, 0.003, 400.0}));
+  EXPECT_EQ(run(create() + " -o " + bad.string() + " --kappa 10").code, 2);
+  EXPECT_EQ(run(sim() + " " + world("jello.w") + " --steps 1 --contact smooth --dhat 0.01").code,
+            2);
+  const Outcome barrier = run(sim() + " " + world("jello.w") +
+                              " --integrator implicit --dt 0.01 --steps 40 --quiet --contact "
+                              "barrier --kappa 500 --stats " +
+                              stats.string());
+  ASSERT_EQ(barrier.code, 0) << barrier.output;
+  {
+    std::ifstream in(stats);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["contact"]["model"], "barrier");
+    EXPECT_EQ(j["contact"]["dhat_m"].get<double>(), kDefaultBarrierDistance);
+    EXPECT_EQ(j["contact"]["kappa_N_per_m"].get<double>(), 500.0);
+    const double least = j["min_obstacle_distance_m"].get<double>();
+    EXPECT_GT(least, 0.0);                      // never inside
+    EXPECT_LT(least, kDefaultBarrierDistance);  // but the barrier was met
+  }
+  // The penalty lets points in: the least distance is negative, the deepest penetration.
+  ASSERT_EQ(run(sim() + " " + world("jello.w") + " --integrator implicit --dt 0.01 --steps 40 " +
+                "--quiet --stats " + stats.string())
+                .code,
+            0);
+  {
+    std::ifstream in(stats);
+    EXPECT_LT(nlohmann::json::parse(in)["min_obstacle_distance_m"].get<double>(), 0.0);
+  }
+  // A world the barrier cannot hold is refused as bad input, naming the file and why.
+  const Outcome spiral =
+      run(sim() + " " + world("showcase.w") + " --steps 1 --contact barrier --quiet");
+  EXPECT_EQ(spiral.code, 1);
+  EXPECT_TRUE(contains(spiral.output, "showcase.w: the barrier contact model needs"))
+      << spiral.output;
 }
 
 // #16: --stats /dev/stdout works (the link is followed to the pipe and written in place), and

@@ -2,13 +2,18 @@
 // the depth and its derivatives are each other's; on every solid, alone and two at a corner,
 // its forces are minus its energy's gradient and its Jacobians the forces' derivatives; every
 // solid's penetrations give back its penalty; the world file's `contact` extension round-trips
-// and bad ones are refused naming the token; a file without it is the penalty.
+// and bad ones are refused naming the token; a file without it is the penalty. The barrier:
+// the same checks outside the solids within dhat, its distances exact (the cone's against a
+// brute-force search), its step bounds never let a point in, and worlds that cannot hold it
+// (a spiral, a point inside) are refused.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <fstream>
+#include <limits>
 #include <random>
 
+#include "solvers/simulation.h"
 #include "solvers/system/jacobian.h"
 #include "src/model.h"
 #include "src/world/world_reader.h"
@@ -251,7 +256,10 @@ TEST(ContactWorlds, TheContactExtensionRoundTripsAndBadOnesAreRefused) {
       EXPECT_NE(std::string(e.what()).find("bad.w:"), std::string::npos) << e.what();
     }
   };
-  refused("contact sticky", "unknown contact model (known: penalty, smooth)");
+  refused("contact sticky", "unknown contact model (known: penalty, smooth, barrier)");
+  refused("contact barrier 0.01", "barrier stiffness kappa");
+  refused("contact barrier 0 400", "barrier distance dhat");
+  refused("contact barrier 0.01 -1", "barrier stiffness kappa");
   refused("contact smooth -0.01", "smooth contact layer");
   refused("contact smooth 0", "smooth contact layer");
   refused("contact smooth", "smooth contact layer");
@@ -262,6 +270,192 @@ TEST(ContactWorlds, TheContactExtensionRoundTripsAndBadOnesAreRefused) {
   upper.replace(upper.find("contact smooth"), 14, "contact SMOOTH");
   std::ofstream(dir.path() / "upper.w") << upper;
   EXPECT_EQ(readWorld(dir.path() / "upper.w").contact, w.contact);
+}
+
+constexpr double kDhat = 0.05;
+const ContactConstants kBarrier{1000.0, 0.3, ContactModel::Barrier, 0.0, kDhat, 800.0};
+
+// Random points of [-2.1, 2.1]^3 outside the model's one solid at a distance in
+// [0.2 dhat, 0.9 dhat], away from where the nearest feature changes.
+std::vector<Vec3> nearPoints(const Obstacle& o, int count) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-2.1, 2.1);
+  std::vector<Vec3> points;
+  Penetration a[kMaxPenetrations], b[kMaxPenetrations];
+  for (long tries = 0; int(points.size()) < count && tries < 20000000; ++tries) {
+    const Vec3 x{u(rng), u(rng), u(rng)};
+    if (o.penetrations(x, kDhat, a) != 1 || a[0].depth > -0.2 * kDhat ||
+        a[0].depth < -0.9 * kDhat) {
+      continue;
+    }
+    bool same = true;
+    for (const Vec3& d : {Vec3{1e-4, 0, 0}, Vec3{0, 1e-4, 0}, Vec3{0, 0, 1e-4}}) {
+      for (double s : {-1.0, 1.0}) {
+        same = same && o.penetrations(x + d * s, kDhat, b) == 1 &&
+               norm(b[0].gradient - a[0].gradient) < 1e-2;
+      }
+    }
+    if (same) points.push_back(x);
+  }
+  EXPECT_EQ(int(points.size()), count);
+  return points;
+}
+
+TEST(BarrierContactLaw, DerivativesAreEachOthersItEndsC2AtDhatAndIsInfiniteAtTheSurface) {
+  const double kappa = 800.0, dhat = 0.01;
+  for (double d : {1e-5, 1e-3, 0.004, 0.0099}) {
+    const double h = 1e-9;
+    const ContactLawValue p = barrierContactLaw(-(d + h), kappa, dhat),
+                          m = barrierContactLaw(-(d - h), kappa, dhat),
+                          c = barrierContactLaw(-d, kappa, dhat);
+    // The law is in the depth q = -d: its force is -db/dd, its stiffness d2b/dd2.
+    EXPECT_NEAR(-(p.energy - m.energy) / (2 * h), c.force, 1e-6 * std::abs(c.force)) << d;
+    EXPECT_NEAR(-(p.force - m.force) / (2 * h), c.stiffness, 1e-5 * c.stiffness) << d;
+    EXPECT_GT(c.energy, 0.0);
+    EXPECT_GT(c.force, 0.0);      // pushes out
+    EXPECT_GT(c.stiffness, 0.0);  // convex: the clamp keeps it
+  }
+  // Value, slope and curvature all reach 0 at dhat: nothing jumps where it begins.
+  const ContactLawValue end = barrierContactLaw(-dhat * (1 - 1e-9), kappa, dhat);
+  EXPECT_LT(end.energy, 1e-15);
+  EXPECT_LT(end.force, 1e-12);
+  EXPECT_LT(end.stiffness, 1e-5 * kappa);
+  EXPECT_EQ(barrierContactLaw(-dhat, kappa, dhat).energy, 0.0);
+  EXPECT_EQ(barrierContactLaw(-1.0, kappa, dhat).force, 0.0);
+  EXPECT_TRUE(std::isinf(barrierContactLaw(0.0, kappa, dhat).energy));
+  EXPECT_TRUE(std::isinf(barrierContactLaw(1e-3, kappa, dhat).energy));
+  // It grows without bound towards the surface, as -kappa dhat^2 ln(d/dhat) there.
+  for (double d : {1e-3, 1e-6, 1e-12}) {
+    const double b = barrierContactLaw(-dhat * d, kappa, dhat).energy;
+    EXPECT_NEAR(b, -kappa * dhat * dhat * std::log(d), 2.5e-3 * b) << d;
+  }
+}
+
+TEST(BarrierContact, ForcesAndJacobiansMatchFiniteDifferencesOutsideEverySolidButTheSpiral) {
+  for (const ModelSpec& spec : everySolid(kBarrier)) {
+    const Model model(spec);
+    const Obstacle& o = *model.obstacles()[0];
+    SCOPED_TRACE(std::string(obstacleName(o.kind())));
+    if (!o.hasExteriorDistance()) {
+      EXPECT_EQ(o.kind(), ObstacleKind::Spiral);
+      continue;
+    }
+    for (const Vec3& x : nearPoints(o, 12)) {
+      expectConsistent(model, x);
+      // The barrier has no damping: D is 0.
+      JacobianAssembler jac(model);
+      jac.assemble(at(x, {0.4, -0.7, 0.3}).x.data(), {});
+      EXPECT_EQ(Eigen::MatrixXd(jac.D()).cwiseAbs().maxCoeff(), 0.0);
+    }
+  }
+}
+
+TEST(BarrierContact, ForcesAndJacobiansMatchFiniteDifferencesWithinDhatOfTwoOrThreeSolids) {
+  ModelSpec spec = onePoint(kBarrier);
+  spec.walls = true;
+  spec.plane = Plane{0, 0, 1, 1.95};  // the floor raised 5 cm
+  spec.sphere = Sphere{{0.0, 0.0, 0.0}, 1.0};
+  const Model model(spec);
+  for (const Vec3& x : {Vec3{1.98, -1.97, 0.5},   // two walls
+                        Vec3{1.97, 1.99, -1.92},  // two walls and the plane
+                        Vec3{0.0, 0.6, 0.82}}) {  // the sphere, 1.6 cm out
+    Penetration touch[kMaxPenetrations];
+    int total = 0;
+    for (const auto& o : model.obstacles()) total += o->penetrations(x, kDhat, touch);
+    EXPECT_GE(total, x.x == 0.0 ? 1 : 2);
+    expectConsistent(model, x);
+  }
+}
+
+// The cone's distance outside: no point of its surface is nearer (a brute-force search over
+// surface points made by projecting random points), and x - D grad(D) lies on the surface.
+TEST(BarrierContact, TheConesExteriorDistanceIsExact) {
+  const Cone cone{{0.2, -0.1, 0.0}, {0.1, 0.2, -1.0}, 1.8, 1.1};
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-2.5, 2.5);
+  std::vector<Vec3> surface;
+  std::vector<Vec3> outside;
+  while (surface.size() < 20000) {
+    const Vec3 x{u(rng), u(rng), u(rng)};
+    if (conePenetration(cone, x)) continue;
+    const Penetration p = coneExterior(cone, x);
+    const Vec3 foot = x + p.gradient * (-p.depth);  // x - D grad(D), grad(D) = -gradient
+    EXPECT_NEAR(norm(p.gradient), 1.0, 1e-12);
+    // The foot is on the surface: just inside it along the normal, outside just beyond.
+    const Vec3 in = foot + p.gradient * 1e-9, out = foot - p.gradient * 1e-9;
+    EXPECT_TRUE(conePenetration(cone, in).has_value() || coneExterior(cone, in).depth > -2e-9);
+    EXPECT_NEAR(coneExterior(cone, out).depth, -1e-9, 1e-12);
+    surface.push_back(foot);
+    if (outside.size() < 200) outside.push_back(x);
+  }
+  for (const Vec3& x : outside) {
+    const double D = -coneExterior(cone, x).depth;
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Vec3& q : surface) nearest = std::min(nearest, norm(x - q));
+    EXPECT_LE(D, nearest + 1e-12);
+    EXPECT_GE(D, nearest - 0.05);  // the sampled surface is dense to a few cm
+  }
+}
+
+// No point starting outside, moved by a step bound's fraction of any update, ends inside; for
+// the walls, the plane and the sphere the bound is the exact time of impact.
+TEST(BarrierContact, StepBoundsNeverLetAPointIn) {
+  for (const ModelSpec& spec : everySolid(kBarrier)) {
+    const Model model(spec);
+    const Obstacle& o = *model.obstacles()[0];
+    if (!o.hasExteriorDistance()) continue;
+    SCOPED_TRACE(std::string(obstacleName(o.kind())));
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<double> u(-1.95, 1.95), m(-3.0, 3.0);
+    int hits = 0;
+    for (int i = 0; i < 4000; ++i) {
+      const Vec3 x{u(rng), u(rng), u(rng)}, dx{m(rng), m(rng), m(rng)};
+      if (!(o.signedDistance(x) > 0.0)) continue;
+      const double s = o.stepBound(x, dx);
+      ASSERT_GE(s, 0.0);
+      ASSERT_LE(s, 1.0);
+      for (double t = 0.0; t <= 1.0; t += 1.0 / 64) {
+        EXPECT_GT(o.signedDistance(x + dx * (0.999 * s * t)), 0.0);
+      }
+      if (s < 1.0) {
+        ++hits;
+        // At the bound the point is at the surface; the cone's advancement stops short of it,
+        // by at most 1 mm where the path grazes the surface (200 advancements).
+        const double left = o.signedDistance(x + dx * s);
+        EXPECT_GE(left, -1e-12);  // exactly at the surface, to round-off
+        EXPECT_LT(left, o.kind() == ObstacleKind::Cone ? 1e-3 : 1e-12);
+      }
+    }
+    EXPECT_GT(hits, 100);  // the case is exercised
+  }
+}
+
+TEST(BarrierContact, WorldsWithASpiralOrAPointInsideAreRefusedAndTheExtensionRoundTrips) {
+  World w = test::loadWorld("jello.w");
+  w.contact = {ContactModel::Barrier, 0.0, 0.002, 350.0};
+  test::TempDir dir;
+  writeWorld(w, dir.path() / "b.w");
+  EXPECT_EQ(readWorld(dir.path() / "b.w").contact, w.contact);
+  EXPECT_NE(test::readFile(dir.path() / "b.w").find("\ncontact barrier 0.002 350\n"),
+            std::string::npos);
+  const Model fine(w);
+  EXPECT_EQ(fine.contactError(initialState(w).x.data()), "");
+
+  World spiral = w;
+  spiral.spiral = Spiral{0.1, -0.2, 1.0, 0.4, 1.6, 1.2, 1.5, 0.3};
+  spiral.plane.reset();
+  const std::string why = Model(spiral).contactError(initialState(spiral).x.data());
+  EXPECT_NE(why.find("spiral does not have yet"), std::string::npos) << why;
+
+  World inside = w;
+  inside.sphere = Sphere{{0.5, 0.5, 0.5}, 0.3};  // around the cube's centre
+  const std::string in = Model(inside).contactError(initialState(inside).x.data());
+  EXPECT_NE(in.find("is inside the sphere"), std::string::npos) << in;
+  // Simulation refuses to step it rather than compute infinite forces.
+  Simulation sim(inside);
+  const StepResult r = sim.step();
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.message.find("inside the sphere"), std::string::npos) << r.message;
 }
 
 }  // namespace

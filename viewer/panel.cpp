@@ -156,6 +156,8 @@ void Panel::syncFromWorld(const Frame& frame) {
   dCollision_ = static_cast<float>(w.dCollision);
   contact_ = w.contact;
   if (w.contact.layer > 0.0) contactLayer_ = static_cast<float>(w.contact.layer);
+  if (w.contact.dhat > 0.0) dhat_ = static_cast<float>(w.contact.dhat);
+  kappa_ = static_cast<float>(w.contact.kappa > 0.0 ? w.contact.kappa : w.kCollision);
   mass_ = static_cast<float>(w.mass);
   dt_ = static_cast<float>(frame.dt);
   if (w.plane) savedPlane_ = w.plane;
@@ -185,8 +187,16 @@ void Panel::constants(const Frame& frame, SimRunner& runner) {
   if (contact_.model == ContactModel::Smooth) {
     contactChanged |= logSlider("layer (m)", &contactLayer_, 1e-4f, 0.1f, "%.3g");
   }
+  if (contact_.model == ContactModel::Barrier) {
+    contactChanged |= logSlider("dhat (m)", &dhat_, 1e-4f, 0.1f, "%.3g");
+    contactChanged |= logSlider("kappa (N/m)", &kappa_, 1.0f, 1e6f, "%.4g");
+  }
   if (contactChanged) {
+    // A barrier asked for with points inside a solid stops the simulation with the reason.
+    const bool barrier = contact_.model == ContactModel::Barrier;
     contact_.layer = contact_.model == ContactModel::Smooth ? double(contactLayer_) : 0.0;
+    contact_.dhat = barrier ? double(dhat_) : 0.0;
+    contact_.kappa = barrier ? double(kappa_) : 0.0;
     edit([law = contact_](World& w) { w.contact = law; });
   }
   if (logSlider("mass (kg)", &mass_, 1e-5f, 1.0f, "%.3g")) {

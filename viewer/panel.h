@@ -71,6 +71,8 @@ class Panel {
   float k_ = 0, d_ = 0, kCollision_ = 0, dCollision_ = 0, mass_ = 0, fieldScale_ = 1;
   ContactLaw contact_;
   float contactLayer_ = float(kDefaultContactLayer);
+  float dhat_ = float(kDefaultBarrierDistance);
+  float kappa_ = 400.0f;  // N/m: the world's kCollision until it is synced
   float dt_ = 0;
   float pullScale_ = 1;
   SolverOptions options_;  // the solver section's copy while editing

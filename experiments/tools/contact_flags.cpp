@@ -7,18 +7,28 @@
 namespace jello {
 
 void addContactFlags(CLI::App& app, ContactFlags& flags, const std::string& what) {
-  char layer[32];
-  std::snprintf(layer, sizeof layer, "%g", kDefaultContactLayer);
+  const auto number = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", v);
+    return std::string(text);
+  };
   app.add_option("--contact", flags.model,
                  "Contact model: " + contactModelNames() + " (" + what + ")");
   app.add_option("--contact-layer", flags.layer,
                  "The smooth model's layer, m: the depth over which contact stiffens to "
                  "kCollision (default " +
-                     std::string(layer) + ")")
+                     number(kDefaultContactLayer) + ")")
+      ->check(cli::positive());
+  app.add_option("--dhat", flags.dhat,
+                 "The barrier's reach, m: the distance from a solid where it begins (default " +
+                     number(kDefaultBarrierDistance) + ")")
+      ->check(cli::positive());
+  app.add_option("--kappa", flags.kappa,
+                 "The barrier's stiffness scale, N/m (default the world's kCollision)")
       ->check(cli::positive());
 }
 
-std::string applyContactFlags(const ContactFlags& flags, ContactLaw& law) {
+std::string applyContactFlags(const ContactFlags& flags, ContactLaw& law, double kCollision) {
   if (!flags.model.empty()) {
     const std::optional<ContactModel> model = contactModelFromName(flags.model);
     if (!model) {
@@ -26,12 +36,21 @@ std::string applyContactFlags(const ContactFlags& flags, ContactLaw& law) {
     }
     law.model = *model;
   }
-  if (law.model != ContactModel::Smooth) {
-    if (flags.layer) return "--contact-layer applies to the smooth contact model only";
-    law.layer = 0.0;
-    return "";
+  const bool smooth = law.model == ContactModel::Smooth;
+  const bool barrier = law.model == ContactModel::Barrier;
+  if (!smooth && flags.layer) return "--contact-layer applies to the smooth contact model only";
+  if (!barrier && (flags.dhat || flags.kappa)) {
+    return std::string(flags.dhat ? "--dhat" : "--kappa") +
+           " applies to the barrier contact model only";
   }
-  law.layer = flags.layer.value_or(law.layer > 0.0 ? law.layer : kDefaultContactLayer);
+  law.layer =
+      smooth ? flags.layer.value_or(law.layer > 0.0 ? law.layer : kDefaultContactLayer) : 0.0;
+  law.dhat =
+      barrier ? flags.dhat.value_or(law.dhat > 0.0 ? law.dhat : kDefaultBarrierDistance) : 0.0;
+  law.kappa = barrier ? flags.kappa.value_or(law.kappa > 0.0 ? law.kappa : kCollision) : 0.0;
+  if (barrier && !(law.kappa > 0.0)) {
+    return "the barrier's kappa defaults to kCollision, which is 0 here: give --kappa";
+  }
   return "";
 }
 

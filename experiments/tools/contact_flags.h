@@ -1,5 +1,6 @@
-// The contact flags jello-create-world and jello-sim share: --contact MODEL and
-// --contact-layer M (src/world/contact_law.h). jello-sim's override the world file's.
+// The contact flags jello-create-world and jello-sim share: --contact MODEL, --contact-layer M
+// (smooth), --dhat M and --kappa K (barrier) (src/world/contact_law.h). jello-sim's override the
+// world file's.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -13,12 +14,15 @@ namespace jello {
 struct ContactFlags {
   std::string model;            // empty: not given
   std::optional<double> layer;  // m
+  std::optional<double> dhat;   // m
+  std::optional<double> kappa;  // N/m
 };
 
 // Registers both; `what` ends the model's help ("default penalty", "overriding the file's").
 void addContactFlags(CLI::App& app, ContactFlags& flags, const std::string& what);
 // Applies the flags given over `law`: a smooth model without --contact-layer keeps the law's
-// layer or takes kDefaultContactLayer. A usage error's text, or empty.
-std::string applyContactFlags(const ContactFlags& flags, ContactLaw& law);
+// layer or takes kDefaultContactLayer; a barrier without --dhat or --kappa keeps the law's or
+// takes kDefaultBarrierDistance and kCollision. A usage error's text, or empty.
+std::string applyContactFlags(const ContactFlags& flags, ContactLaw& law, double kCollision);
 
 }  // namespace jello

@@ -145,7 +145,8 @@ std::string apply(Flags& f, jello::SceneSpec& spec) {
     return "unknown integrator '" + f.integrator + "' (known: " + jello::integratorNameList() + ")";
   }
   spec.integrator = *kind;
-  if (std::string error = jello::applyContactFlags(f.contact, spec.contact); !error.empty()) {
+  if (std::string error = jello::applyContactFlags(f.contact, spec.contact, spec.kCollision);
+      !error.empty()) {
     return error;
   }
   f.field = CLI::detail::to_lower(f.field);

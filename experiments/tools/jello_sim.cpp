@@ -212,7 +212,9 @@ nlohmann::json statistics(const Options& opt, const Simulation& sim, const Outco
       {"dt_s", sim.dt()},
       {"contact",
        {{"model", std::string(jello::contactModelName(sim.world().contact.model))},
-        {"layer_m", sim.world().contact.layer}}},
+        {"layer_m", sim.world().contact.layer},
+        {"dhat_m", sim.world().contact.dhat},
+        {"kappa_N_per_m", sim.world().contact.kappa}}},
       {"points", s.numPoints()},
       {"springs", sim.model().springs().numSprings()},
       {"steps", o.done},
@@ -227,6 +229,13 @@ nlohmann::json statistics(const Options& opt, const Simulation& sim, const Outco
       {"diverged", o.diverged},
       {"interrupted", o.interrupted != 0},
   };
+  // The least signed distance to a solid over the run (< 0: the deepest penetration); null
+  // without solids.
+  if (const std::optional<double> d = sim.minObstacleDistance()) {
+    stats["min_obstacle_distance_m"] = *d;
+  } else {
+    stats["min_obstacle_distance_m"] = nullptr;
+  }
   for (const jello::Statistic& st : sim.integrator().statistics()) {
     stats["solver"][st.name] = st.value;
     if (st.name == "newton_unconverged_steps" && st.value > 0 && o.unconverged.empty()) {
@@ -329,7 +338,8 @@ int run(const Options& opt) {
   if (!jello::checkOutputs("jello-sim", outputs)) return kExitInput;
   std::optional<jello::World> world = loadWorld(opt);
   if (!world) return kExitInput;
-  if (std::string error = jello::applyContactFlags(opt.contact, world->contact); !error.empty()) {
+  if (std::string error = jello::applyContactFlags(opt.contact, world->contact, world->kCollision);
+      !error.empty()) {
     std::fprintf(stderr, "jello-sim: error: %s\n", error.c_str());
     return kExitUsage;
   }
@@ -344,6 +354,11 @@ int run(const Options& opt) {
   }
   const double kElastic = world->kElastic, dElastic = world->dElastic;
   Simulation sim(std::move(*world), kind, opt.dt, opt.solver);
+  if (std::string error = sim.model().contactError(sim.state().x.data()); !error.empty()) {
+    std::fprintf(stderr, "jello-sim: error: %s: %s\n", opt.world.c_str(), error.c_str());
+    return kExitInput;
+  }
+  sim.trackObstacleDistance();
   Outcome o;
   if (const std::optional<long> total = stepCount(opt, sim)) {
     o.total = *total;

@@ -25,6 +25,19 @@ double LinearizedBackwardEuler::residual(const Model& model, const State& s, dou
   return scale > 0.0 ? g_.norm() / scale : 0.0;
 }
 
+void LinearizedBackwardEuler::keepOutside(const Model& model, const State& s, double h) {
+  x1_ = s.x + h * v1_;
+  if (!model.barrierContact()) return;
+  // The barrier: the move h v1 may not carry a point into a solid. Cut to 0.9 of the largest
+  // that keeps every point out (the step is then not backward Euler's: counted).
+  move_ = h * v1_;
+  const double bound = model.contactStepBound(s.x.data(), move_.data());
+  if (bound >= 1.0) return;
+  v1_ *= 0.9 * bound;
+  x1_ = s.x + h * v1_;
+  ++barrierCuts_;
+}
+
 StepResult LinearizedBackwardEuler::step(const Model& model, State& s, double h) {
   prepare(model);
   model.forces(s.x, s.v, f_);
@@ -35,7 +48,7 @@ StepResult LinearizedBackwardEuler::step(const Model& model, State& s, double h)
   // dv_ still holds the last step's dv: a good first guess for CG.
   if (StepResult r = factorAndSolve(h, rhs_, dv_); !r.ok) return r;
   v1_ = s.v + dv_;
-  x1_ = s.x + h * v1_;
+  keepOutside(model, s, h);
 
   int iterations = 1;
   lastResidual_ = 0.0;
@@ -61,7 +74,7 @@ StepResult LinearizedBackwardEuler::step(const Model& model, State& s, double h)
       delta_.setZero(rhs_.size());  // a correction: small, so start CG from zero
       if (StepResult r = factorAndSolve(h, rhs_, delta_); !r.ok) return r;
       v1_ += delta_;
-      x1_ = s.x + h * v1_;
+      keepOutside(model, s, h);
       ++iterations;
     }
   }
@@ -79,6 +92,7 @@ std::vector<Statistic> LinearizedBackwardEuler::statistics() const {
       {"newton_iterations", static_cast<double>(newtonIterations_)},
       {"newton_unconverged_steps", static_cast<double>(unconverged_)},
       {"contact_onset_steps", static_cast<double>(contactSteps_)},
+      {"barrier_cuts", static_cast<double>(barrierCuts_)},
   };
   system_.appendStatistics(stats);
   return stats;

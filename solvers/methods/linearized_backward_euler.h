@@ -14,7 +14,9 @@
 // residual
 //   g(v1) = M (v1 - v0) - h f(x0 + h v1, v1)
 // below contactNewtonTolerance relative to |M (v1 - v0)| + |h f|.
-// The force field is treated explicitly (its gradient is not symmetric).
+// The force field is treated explicitly (its gradient is not symmetric). With barrier contact
+// a move h v1 that would carry a point into a solid is cut to 0.9 of the largest that keeps
+// every point out (v1 scaled, counted in barrier_cuts): then the step is not backward Euler's.
 #pragma once
 
 #include <memory>
@@ -43,16 +45,19 @@ class LinearizedBackwardEuler final : public Integrator {
  private:
   void prepare(const Model& model);
   double residual(const Model& model, const State& s, double h);
+  // x1 = x0 + h v1, with v1 first cut by the barrier's bound (see above).
+  void keepOutside(const Model& model, const State& s, double h);
   // Factors M - h D - h^2 K of the last assembly and solves it for rhs into x (x on entry:
   // CG's initial guess).
   StepResult factorAndSolve(double h, const Eigen::VectorXd& rhs, Eigen::VectorXd& x);
 
   ImplicitOptions options_;
   ImplicitSystem system_;
-  Eigen::VectorXd f_, rhs_, dv_, delta_, v1_, x1_, g_;  // dv_: the last step's, CG's warm start
+  Eigen::VectorXd f_, rhs_, dv_, delta_, v1_, x1_, g_,
+      move_;  // dv_: the last step's, CG's warm start
   double lastResidual_ = 0.0;
   int lastIterations_ = 0;
-  long steps_ = 0, newtonIterations_ = 0, unconverged_ = 0, contactSteps_ = 0;
+  long steps_ = 0, newtonIterations_ = 0, unconverged_ = 0, contactSteps_ = 0, barrierCuts_ = 0;
 };
 
 }  // namespace jello

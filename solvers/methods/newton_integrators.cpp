@@ -12,6 +12,9 @@ namespace {
 
 // Plain seed iterations before Chebyshev's start (ProjectiveOptions::chebyshevDelay's default).
 constexpr int kSeedChebyshevDelay = 2;
+// The barrier's line search starts at this fraction of the largest step that keeps every point
+// out of every solid, so a step ends at a positive distance however the energy decides.
+constexpr double kBarrierStepFraction = 0.9;
 
 // Unknown: the displacement d = y - x0 (small, so no digits are lost to the positions' size).
 // Forms are filled into the integrator's own, so their vectors are allocated once.
@@ -94,6 +97,18 @@ StepResult NewtonIntegrator::prepareNewtonMatrix(double h, bool refactor) {
   factorA_ = a;
   factorB_ = b;
   return StepResult::success();
+}
+
+std::pair<double, double> NewtonIntegrator::barrierStepBounds(const Model& model,
+                                                              const Eigen::VectorXd& d,
+                                                              const Eigen::VectorXd& delta) {
+  const ImplicitStepForm& form = form_;
+  trial_ = form.x0 + d;  // y
+  const double y = model.contactStepBound(trial_.data(), delta.data());
+  if (form.theta == 1.0) return {y, y};
+  trial_ = form.x0 + form.theta * d;  // x_e, moving by theta delta
+  dTrial_ = form.theta * delta;
+  return {y, model.contactStepBound(trial_.data(), dTrial_.data())};
 }
 
 StepResult NewtonIntegrator::seed(const Model& model, double inertia, double h) {
@@ -184,6 +199,13 @@ StepResult NewtonIntegrator::solve(const Model& model, const State& s, double h,
   if (options_.seedIterations > 0) {
     if (StepResult res = seed(model, inertia, h); !res.ok) return res;
   }
+  const bool barrier = model.barrierContact();
+  if (barrier) {
+    // The start must be outside every solid, as x0 is: the guess pulled back along d from x0
+    // (the path of x_e = x0 + theta d is part of y's).
+    const double bound = model.contactStepBound(form.x0.data(), d_.data());
+    if (bound < 1.0) d_ *= kBarrierStepFraction * bound;
+  }
   converged = false;
   int k = 0;  // this solve's iterations; `iterations` sums the step's, retries included
   double previousNorm = std::numeric_limits<double>::infinity();
@@ -212,9 +234,21 @@ StepResult NewtonIntegrator::solve(const Model& model, const State& s, double h,
     // tolerance; not kept.
     if (StepResult res = system_.solve(rhs_, delta_); !res.ok) return res;
     if (!delta_.allFinite()) return StepResult::failure("Newton produced a non-finite update");
+    // The barrier: no step may carry y, or x_e, into a solid; the line search starts at a
+    // fraction of the largest step that keeps them out (Li et al. 2020's filtered line search).
+    double alphaMax = 1.0;
+    if (barrier) {
+      const auto [yBound, xeBound] = barrierStepBounds(model, d_, delta_);
+      // Where y would enter a solid before x_e comes near it (midpoint: x_e halfway), the
+      // barrier, felt at x_e only, cannot stop y: this h has no step outside, and taking 0.9 of
+      // the way each iteration would bring y to the surface in round-off. Unconverged: the
+      // step is retried in halves, where x_e and y are closer.
+      if (yBound < 1.0 && yBound < xeBound) break;
+      alphaMax = std::min(yBound, xeBound);
+    }
     // An update this small is the answer to within it: the floor that ends the iterations at
     // rest, where round-off keeps the relative residual from falling.
-    if (delta_.cwiseAbs().maxCoeff() <= options_.newtonPositionTolerance) {
+    if (alphaMax >= 1.0 && delta_.cwiseAbs().maxCoeff() <= options_.newtonPositionTolerance) {
       d_ += delta_;
       converged = true;
       break;
@@ -223,7 +257,8 @@ StepResult NewtonIntegrator::solve(const Model& model, const State& s, double h,
     // Backtracking line search on E_k (frozen damping directions, field and user force).
     model.externalForces(xe_.data(), external_);  // field and user force at the iterate
     const double slope = r_.dot(delta_);
-    double alpha = 1.0;
+    const double alphaStart = alphaMax >= 1.0 ? 1.0 : kBarrierStepFraction * alphaMax;
+    double alpha = alphaStart;
     if (slope < 0.0) {
       const double e0 = merit(model, inertia, d_);
       // Near the answer the decrease is below E's round-off (E sums the energy of every
@@ -246,7 +281,7 @@ StepResult NewtonIntegrator::solve(const Model& model, const State& s, double h,
       // freezes damping and field): creeping along it would stall Newton, so take the whole
       // Newton step, as plain Newton does, and count it.
       if (!descended) {
-        alpha = 1.0;
+        alpha = alphaStart;
         ++searchFailures_;
       }
     }

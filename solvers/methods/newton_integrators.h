@@ -44,6 +44,9 @@
 // down to h / 2^newtonHalvings: a contact whose onset the full step jumped over is met by the
 // halves); a sub-step still unconverged at that floor is accepted, counted, and the step returns
 // StepResult::unconverged, never silent. bdf2's halves are started by backward Euler (another h).
+// With barrier contact (src/world/contact_law.h) the guess and every update are bounded so
+// that no point (neither y nor x_e) reaches a solid: the line search starts at 0.9 of the
+// largest feasible step, and the merit, infinite inside, rejects the rest (Li et al. 2020).
 // Optionally (seedIterations) Newton starts where a few iterations with the constant projective
 // matrix P = M + L(a c + b k) left the inertial guess: for backward Euler these are projective
 // dynamics' iterations (solvers/methods/projective_integrator.h), for every method a descent that
@@ -107,6 +110,10 @@ class NewtonIntegrator : public Integrator {
   // Assembles K and D at the iterate and, when `refactor`, factors
   // A = M - (sigma h^2/gamma) D - (theta h^2/gamma) K there.
   StepResult prepareNewtonMatrix(double h, bool refactor);
+  // The barrier's bounds on a Newton update delta from d: the largest s <= 1 with y, and with
+  // x_e, outside every solid along s delta (Model::contactStepBound).
+  std::pair<double, double> barrierStepBounds(const Model& model, const Eigen::VectorXd& d,
+                                              const Eigen::VectorXd& delta);
   // options_.seedIterations projective iterations on d_ (ImplicitOptions::seedIterations).
   StepResult seed(const Model& model, double inertia, double h);
   std::pair<double, double> matrixCoefficients(double h) const;

@@ -14,6 +14,10 @@
 namespace jello {
 namespace {
 
+// The barrier's updates go this fraction of the largest step that keeps every point outside
+// (as the Newton integrators' line search starts).
+constexpr double kBarrierStepFraction = 0.9;
+
 using Clock = std::chrono::steady_clock;
 
 // A contact change of at most this many points updates the factor (cholmod_updown) instead of
@@ -160,6 +164,18 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
     x[i] = y_[i] = x0[i] + h * v0[i];
     v[i] = (x[i] - x0[i]) * inverseH;
   }
+  const bool barrier = model.barrierContact();
+  if (barrier) {
+    // The inertial prediction may lie inside a solid: the iterations start from it pulled back
+    // along h v0 from x0, outside.
+    for (std::ptrdiff_t i = 0; i < size; ++i) v[i] = h * v0[i];  // scratch: the move
+    const double bound = model.contactStepBound(x0, v);
+    const double scale = bound < 1.0 ? kBarrierStepFraction * bound : 1.0;
+    for (std::ptrdiff_t i = 0; i < size; ++i) {
+      x[i] = x0[i] + scale * h * v0[i];
+      v[i] = (x[i] - x0[i]) * inverseH;
+    }
+  }
   int iterations = 0;
   chebyshev_.start();  // ProjectiveOptions::chebyshevRho
   for (; iterations < options_.iterations; ++iterations) {
@@ -203,6 +219,15 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
       }
       previous_ = x_;
     }
+    // The barrier (src/world/contact_law.h): its force is in f, not in A, so an update may aim
+    // into a solid; it is cut to 0.9 of the largest that keeps every point outside.
+    if (barrier) {
+      const double bound = model.contactStepBound(x, d);
+      if (bound < 1.0) {
+        delta_ *= kBarrierStepFraction * bound;
+        ++barrierCuts_;
+      }
+    }
     // x += delta, the next iterate's velocity and the largest move, in one pass.
     double update = 0.0;
     int finite = 1;
@@ -237,6 +262,7 @@ std::vector<Statistic> ProjectiveIntegrator::statistics() const {
       {"projective_last_update_m", lastUpdate_},
       {"factorizations", static_cast<double>(factorizations_)},
       {"contact_set_changes", static_cast<double>(contactChanges_)},
+      {"barrier_cuts", static_cast<double>(barrierCuts_)},
       {"factor_updates", static_cast<double>(updates_)},
       {"factor_time_s", factorSeconds_},
       {"chebyshev_restarts", static_cast<double>(chebyshev_.restarts())},

@@ -22,6 +22,9 @@
 // field and the user force are evaluated at the iterate (lagged one iteration): at the fixed point
 // they are exactly where backward Euler evaluates them, so the iterations converge to the
 // `implicit` step, damping included (the lag converges because h c/(m + k h^2) << 1).
+// With barrier contact the barrier's force is evaluated at the iterate like the others (no
+// contact weights: no point is ever inside), and each update is cut to 0.9 of the largest that
+// keeps every point outside every solid (Model::contactStepBound), counted in barrier_cuts.
 // Options: iterations per step (10) and a tolerance (m): the iterations stop early when an
 // update moves no coordinate more than it (0: always all iterations); Chebyshev acceleration
 // (ProjectiveOptions::chebyshevRho).
@@ -83,6 +86,7 @@ class ProjectiveIntegrator final : public Integrator {
   double lastUpdate_ = 0.0;
   std::vector<std::pair<int, double>> changes_;  // a coordinate's changed contact weights
   long steps_ = 0, iterations_ = 0, factorizations_ = 0, contactChanges_ = 0, updates_ = 0;
+  long barrierCuts_ = 0;  // updates cut short by the barrier
   double factorSeconds_ = 0.0, solveSeconds_ = 0.0;
 };
 

@@ -72,12 +72,22 @@ void WallContact::addPenaltyJacobian(const double* x, int n, JacobianBlocks& out
     }
 }
 
-int WallContact::penetrations(const Vec3& x, Penetration* out) const {
+bool WallContact::mayTouch(const double* x, int n, int lo, int hi, double reach) const {
+  if (reach == 0.0) return !allInside(x, n, lo, hi);
+  const double inner = kBoxHalfSize - reach;
+  for (int e = 0; e < 3; ++e)
+    for (int i = e * n + lo; i < e * n + hi; ++i) {
+      if (!(std::abs(x[i]) < inner)) return true;
+    }
+  return false;
+}
+
+int WallContact::penetrations(const Vec3& x, double reach, Penetration* out) const {
   const double c[3] = {x.x, x.y, x.z};
   int count = 0;
   for (int axis = 0; axis < 3; ++axis) {
     const double over = std::abs(c[axis]) - kBoxHalfSize;
-    if (!(over > 0.0)) continue;
+    if (!(over > -reach)) continue;
     Penetration& q = out[count++];
     q = Penetration{};
     q.depth = over;
@@ -85,6 +95,22 @@ int WallContact::penetrations(const Vec3& x, Penetration* out) const {
     q.gradient = Vec3{axis == 0 ? sign : 0.0, axis == 1 ? sign : 0.0, axis == 2 ? sign : 0.0};
   }
   return count;
+}
+
+double WallContact::signedDistance(const Vec3& x) const {
+  return kBoxHalfSize - std::max({std::abs(x.x), std::abs(x.y), std::abs(x.z)});
+}
+
+double WallContact::stepBound(const Vec3& x, const Vec3& dx) const {
+  const double c[3] = {x.x, x.y, x.z}, d[3] = {dx.x, dx.y, dx.z};
+  double bound = 1.0;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (d[axis] == 0.0) continue;
+    // The wall it moves towards, at +-2: reached at s = (2 - sign x) / |dx|.
+    const double gap = kBoxHalfSize - (d[axis] > 0.0 ? c[axis] : -c[axis]);
+    bound = std::min(bound, std::max(0.0, gap) / std::abs(d[axis]));
+  }
+  return bound;
 }
 
 double WallContact::depth(const Vec3& x) const {
@@ -162,13 +188,19 @@ void PlaneContact::addPenaltyJacobian(const double* x, int n, JacobianBlocks& ou
   }
 }
 
-int PlaneContact::penetrations(const Vec3& x, Penetration* out) const {
+int PlaneContact::penetrations(const Vec3& x, double reach, Penetration* out) const {
   const double s = side(x);
-  if (!(s < 0.0)) return 0;
+  if (!(s < reach)) return 0;
   out[0] = Penetration{};
   out[0].depth = -s;
   out[0].gradient = normal_ * -1.0;
   return 1;
+}
+
+double PlaneContact::stepBound(const Vec3& x, const Vec3& dx) const {
+  const double approach = -dot(normal_, dx);  // how fast the side falls along dx
+  if (!(approach > 0.0)) return 1.0;
+  return std::min(1.0, std::max(0.0, side(x)) / approach);
 }
 
 double PlaneContact::depth(const Vec3& x) const {
@@ -243,10 +275,10 @@ void SphereContact::addPenaltyJacobian(const double* x, int n, JacobianBlocks& o
   }
 }
 
-int SphereContact::penetrations(const Vec3& x, Penetration* out) const {
+int SphereContact::penetrations(const Vec3& x, double reach, Penetration* out) const {
   const Vec3 r = x - sphere_.center;
   const double l = norm(r);
-  if (!(l < sphere_.radius)) return 0;
+  if (!(l < sphere_.radius + reach)) return 0;
   Penetration& q = out[0];
   q = Penetration{};
   q.depth = sphere_.radius - l;
@@ -259,6 +291,19 @@ int SphereContact::penetrations(const Vec3& x, Penetration* out) const {
     q.gradient = Vec3{0.0, 0.0, -1.0};  // the centre: pushed up, as the penalty does
   }
   return 1;
+}
+
+double SphereContact::stepBound(const Vec3& x, const Vec3& dx) const {
+  // |r + s dx|^2 = R^2: a s^2 + b s + c = 0 with c > 0 outside; the first root, if it comes.
+  const Vec3 r = x - sphere_.center;
+  const double a = dot(dx, dx), b = 2.0 * dot(r, dx);
+  const double c = dot(r, r) - sphere_.radius * sphere_.radius;
+  if (!(a > 0.0) || !(b < 0.0)) return 1.0;
+  if (!(c > 0.0)) return 0.0;
+  const double disc = b * b - 4.0 * a * c;
+  if (disc < 0.0) return 1.0;
+  // The smaller root, written to keep its digits: 2c / (-b + sqrt(disc)).
+  return std::min(1.0, 2.0 * c / (-b + std::sqrt(disc)));
 }
 
 double SphereContact::depth(const Vec3& x) const {

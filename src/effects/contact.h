@@ -27,11 +27,11 @@ class WallContact final : public Obstacle {
   double penaltyEnergy(const double* x, int n) const override;
   // K = -kc e_c e_c^T, D = -dc e_c e_c^T on the diagonal block of each violated wall's point.
   void addPenaltyJacobian(const double* x, int n, JacobianBlocks& out) const override;
-  bool mayTouch(const double* x, int n, int lo, int hi) const override {
-    return !allInside(x, n, lo, hi);
-  }
-  // One per wall passed: depth |x_c| - 2, gradient sign(x_c) e_c.
-  int penetrations(const Vec3& x, Penetration* out) const override;
+  bool mayTouch(const double* x, int n, int lo, int hi, double reach) const override;
+  // One per wall passed (or within reach): depth |x_c| - 2, gradient sign(x_c) e_c.
+  int penetrations(const Vec3& x, double reach, Penetration* out) const override;
+  double signedDistance(const Vec3& x) const override;  // to the nearest wall
+  double stepBound(const Vec3& x, const Vec3& dx) const override;
   double depth(const Vec3& x) const override;
   bool contactBegins(const double* x0, const double* x1, int n) const override;
   int contactSprings(const Vec3& x) const override;
@@ -53,7 +53,9 @@ class PlaneContact final : public Obstacle {
   // K = -kc n n^T, D = -dc n n^T for each point on the solid side.
   void addPenaltyJacobian(const double* x, int n, JacobianBlocks& out) const override;
   // Depth -(n.x + offset), gradient -n.
-  int penetrations(const Vec3& x, Penetration* out) const override;
+  int penetrations(const Vec3& x, double reach, Penetration* out) const override;
+  double signedDistance(const Vec3& x) const override { return side(x); }
+  double stepBound(const Vec3& x, const Vec3& dx) const override;
   double depth(const Vec3& x) const override;
   bool contactBegins(const double* x0, const double* x1, int n) const override;
   int contactSprings(const Vec3& x) const override;
@@ -84,7 +86,11 @@ class SphereContact final : public Obstacle {
   // is the surface's curvature; positive, so the clamp drops it), D = -dc n n^T.
   void addPenaltyJacobian(const double* x, int n, JacobianBlocks& out) const override;
   // Depth R - l, gradient -n, Hessian -(I - n n^T)/l (at the centre: pushed up, no Hessian).
-  int penetrations(const Vec3& x, Penetration* out) const override;
+  int penetrations(const Vec3& x, double reach, Penetration* out) const override;
+  double signedDistance(const Vec3& x) const override {
+    return norm(x - sphere_.center) - sphere_.radius;
+  }
+  double stepBound(const Vec3& x, const Vec3& dx) const override;
   double depth(const Vec3& x) const override;
   bool contactBegins(const double* x0, const double* x1, int n) const override;
   int contactSprings(const Vec3& x) const override;

@@ -1,6 +1,8 @@
 // The contact laws other than the course's penalty, on every obstacle through its
 // penetrations (src/effects/obstacle.h).
+#include <cmath>
 #include <cstddef>
+#include <limits>
 
 #include "src/effects/obstacle.h"
 
@@ -29,22 +31,59 @@ ContactLawValue smoothContactLaw(double q, double k, double layer) {
   return {0.5 * k * s * s + k * layer * layer / 24.0, k * s, k};
 }
 
+ContactLawValue barrierContactLaw(double q, double kappa, double dhat) {
+  const double d = -q;
+  if (!(d < dhat)) return {};
+  if (!(d > 0.0)) {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    return {inf, inf, inf};
+  }
+  // b = -kappa g^2 L, g = d - dhat, L = ln(d/dhat);
+  // b' = -kappa (2 g L + g^2/d),  b'' = -kappa (2 L + 4 g/d - g^2/d^2); e(q) = b(-q).
+  const double g = d - dhat, L = std::log(d / dhat);
+  return {-kappa * g * g * L, kappa * (2.0 * g * L + g * g / d),
+          -kappa * (2.0 * L + 4.0 * g / d - g * g / (d * d))};
+}
+
 ContactLawValue Obstacle::law(double depth) const {
+  if (k_.model == ContactModel::Barrier) return barrierContactLaw(depth, k_.kappa, k_.dhat);
   return smoothContactLaw(depth, k_.stiffness, k_.layer);
+}
+
+// The damping's weight: the smooth law's rises with its stiffness, w = e''/kc, 0 at the surface
+// and 1 past the layer; the barrier has none.
+double Obstacle::dampingWeight(const ContactLawValue& e) const {
+  if (k_.model == ContactModel::Barrier) return 0.0;
+  return k_.stiffness > 0.0 ? e.stiffness / k_.stiffness : 1.0;
+}
+
+double Obstacle::stepBound(const Vec3& x, const Vec3& dx) const {
+  // Conservative advancement: the distance is 1-Lipschitz, so x + s dx cannot reach the surface
+  // before s grows by d(x + s dx) / |dx|.
+  const double length = norm(dx);
+  if (!(length > 0.0)) return 1.0;
+  double s = 0.0;
+  for (int i = 0; i < 200; ++i) {
+    const double d = signedDistance(x + dx * s);
+    if (!(d > 1e-9)) return s;
+    s += d / length;
+    if (s >= 1.0) return 1.0;
+  }
+  return s;
 }
 
 bool Obstacle::addLawForces(const double* x, const double* v, double* f, int n, int lo,
                             int hi) const {
-  if (!mayTouch(x, n, lo, hi)) return false;
+  const double r = reach();
+  if (!mayTouch(x, n, lo, hi, r)) return false;
   Penetration touch[kMaxPenetrations];
   for (int p = lo; p < hi; ++p) {
-    const int count = penetrations(pointAt(x, n, p), touch);
+    const int count = penetrations(pointAt(x, n, p), r, touch);
     for (int i = 0; i < count; ++i) {
       const Penetration& q = touch[i];
       const ContactLawValue e = law(q.depth);
       const Vec3 normal = unitVector(q.gradient * -1.0);
-      // The damping rises with the stiffness: w = e''/kc, 0 at the surface, 1 past the layer.
-      const double w = k_.stiffness > 0.0 ? e.stiffness / k_.stiffness : 1.0;
+      const double w = dampingWeight(e);
       const double vn = dot(normal, pointAt(v, n, p));
       add(f, n, p, q.gradient * -e.force - normal * (k_.damping * w * vn));
     }
@@ -54,9 +93,10 @@ bool Obstacle::addLawForces(const double* x, const double* v, double* f, int n, 
 
 double Obstacle::lawEnergy(const double* x, int n) const {
   Penetration touch[kMaxPenetrations];
+  const double r = reach();
   double energy = 0.0;
   for (int p = 0; p < n; ++p) {
-    const int count = penetrations(pointAt(x, n, p), touch);
+    const int count = penetrations(pointAt(x, n, p), r, touch);
     for (int i = 0; i < count; ++i) energy += law(touch[i].depth).energy;
   }
   return energy;
@@ -64,8 +104,9 @@ double Obstacle::lawEnergy(const double* x, int n) const {
 
 void Obstacle::addLawJacobian(const double* x, int n, JacobianBlocks& out) const {
   Penetration touch[kMaxPenetrations];
+  const double r = reach();
   for (int p = 0; p < n; ++p) {
-    const int count = penetrations(pointAt(x, n, p), touch);
+    const int count = penetrations(pointAt(x, n, p), r, touch);
     double* K = out.diagK + 9 * static_cast<std::ptrdiff_t>(p);
     double* D = out.diagD + 9 * static_cast<std::ptrdiff_t>(p);
     for (int i = 0; i < count; ++i) {
@@ -76,7 +117,7 @@ void Obstacle::addLawJacobian(const double* x, int n, JacobianBlocks& out) const
         for (int j = 0; j < 9; ++j) K[j] -= e.force * q.hessian[j];
       }
       const Vec3 normal = unitVector(q.gradient * -1.0);
-      const double w = k_.stiffness > 0.0 ? e.stiffness / k_.stiffness : 1.0;
+      const double w = dampingWeight(e);
       addOuter(D, normal, normal, -k_.damping * w);
     }
   }

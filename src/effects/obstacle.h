@@ -4,7 +4,10 @@
 //   energy = e(q),   f = -e'(q) grad(q) - dc w(q) (n.v) n,
 // with n the unit normal into free space; the course's penalty is e = 1/2 kc q^2 and w = 1 (a
 // rest-length-0 spring to the surface), the smooth law rises over a layer (contact_law.h) with
-// w = e''/kc, so its damping starts from 0 at the surface as its stiffness does. It answers every
+// w = e''/kc, so its damping starts from 0 at the surface as its stiffness does; the barrier is
+// a law in the signed depth q = -d within dhat outside the solid (d the exact distance), with
+// no damping (w = 0) and infinite energy at d <= 0, which the implicit methods' step bounds keep
+// every point from reaching (stepBound). It answers every
 // question the model and the solvers ask of contact (forces, energy, Jacobian, depth, onset, the
 // contact weights of the projective matrices, CVODE's root functions), so Model, solvers/cvode/,
 // solvers/system/implicit_system.cpp and solvers/methods/projective_integrator.cpp iterate
@@ -48,6 +51,8 @@ struct ContactConstants {
   double damping = 0.0;    // N*s/m (dCollision)
   ContactModel model = ContactModel::Penalty;
   double layer = 0.0;  // m, the smooth law's layer
+  double dhat = 0.0;   // m, the barrier's reach
+  double kappa = 0.0;  // N/m, the barrier's stiffness scale
 };
 
 // A contact's depth e(q) law at depth q > 0: energy (J), its first derivative (N: the force's
@@ -61,10 +66,13 @@ struct ContactLawValue {
 // quadratic with the same value, slope and curvature at q = layer, kc/2 (q - layer/2)^2 +
 // kc layer^2 / 24. Its energy is C2 in q, 0 with its derivatives at the surface.
 ContactLawValue smoothContactLaw(double depth, double stiffness, double layer);
+// The barrier (Li et al. 2020) in the signed depth q = -d: b(d) = -kappa (d - dhat)^2 ln(d/dhat)
+// for 0 < d < dhat, 0 beyond; its q-derivatives -b'(d) and b''(d). At d <= 0 all three are +inf.
+ContactLawValue barrierContactLaw(double depth, double kappa, double dhat);
 
 // One contact of a point: how deep it is inside a solid, and the depth's derivatives.
 struct Penetration {
-  double depth = 0.0;                               // m, > 0
+  double depth = 0.0;                               // m, > 0 inside; -distance outside
   Vec3 gradient;                                    // of the depth (points into the solid)
   double hessian[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};  // row-major, of the depth
 };
@@ -105,8 +113,21 @@ class Obstacle {
     }
   }
   // Writes each contact x has with this solid (at most kMaxPenetrations) to out; returns how
-  // many.
-  virtual int penetrations(const Vec3& x, Penetration* out) const = 0;
+  // many. With reach > 0 also those outside, within reach of the surface: their depth is minus
+  // their exact distance to it (the spiral has none: it has no exterior distance yet).
+  virtual int penetrations(const Vec3& x, double reach, Penetration* out) const = 0;
+  int penetrations(const Vec3& x, Penetration* out) const { return penetrations(x, 0.0, out); }
+  // How far outside the law reaches: the barrier's dhat, 0 for the others.
+  double reach() const { return k_.model == ContactModel::Barrier ? k_.dhat : 0.0; }
+  // The signed distance from x to the solid (m): > 0 outside, exact (the walls: to the nearest
+  // wall); -depth inside. The spiral, whose exterior distance is unknown, says +inf outside.
+  virtual double signedDistance(const Vec3& x) const = 0;
+  // False for a solid without an exterior distance (the spiral): the barrier cannot hold it.
+  virtual bool hasExteriorDistance() const { return true; }
+  // The largest s in [0, 1] such that x + t dx stays outside the solid for t in [0, s), x
+  // outside: closed form for walls, plane and sphere; conservative advancement on the exact
+  // distance for the cone (within 1e-9 m of the surface); 1 for the spiral.
+  virtual double stepBound(const Vec3& x, const Vec3& dx) const;
 
   // How deep x is inside the solid (m): > 0 in contact, 0 in free space (the walls: the
   // deepest of the walls it passed).
@@ -136,7 +157,8 @@ class Obstacle {
   virtual double penaltyEnergy(const double* x, int n) const = 0;
   virtual void addPenaltyJacobian(const double* x, int n, JacobianBlocks& out) const = 0;
   // False when no point of [lo, hi) can touch (a cheap check; the walls').
-  virtual bool mayTouch(const double* /*x*/, int /*n*/, int /*lo*/, int /*hi*/) const {
+  virtual bool mayTouch(const double* /*x*/, int /*n*/, int /*lo*/, int /*hi*/,
+                        double /*reach*/) const {
     return true;
   }
 
@@ -154,6 +176,7 @@ class Obstacle {
  private:
   // The law's value at depth q (not the penalty's, which has its own loops).
   ContactLawValue law(double depth) const;
+  double dampingWeight(const ContactLawValue& e) const;
   bool addLawForces(const double* x, const double* v, double* f, int n, int lo, int hi) const;
   double lawEnergy(const double* x, int n) const;
   void addLawJacobian(const double* x, int n, JacobianBlocks& out) const;

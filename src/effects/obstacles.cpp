@@ -53,6 +53,48 @@ std::optional<Penetration> conePenetration(const Cone& cone, const Vec3& x) {
   return p;
 }
 
+Penetration coneExterior(const Cone& cone, const Vec3& x) {
+  const Vec3 d = unitVector(cone.axis);
+  const Vec3 rel = x - cone.apex;
+  const double h = dot(d, rel);
+  const Vec3 radial = rel - d * h;
+  const double r = norm(radial);
+  const Vec3 er = r > 0.0 ? radial * (1.0 / r) : perpendicular(d);
+  const double H = cone.height, R = cone.radius;
+  // The nearest point of each edge, (h, r) coordinates; an interior one leaves D linear there.
+  const double t = std::clamp((h * H + r * R) / (H * H + R * R), 0.0, 1.0);
+  const double lateral[2] = {t * H, t * R};
+  const double base[2] = {H, std::clamp(r, 0.0, R)};
+  const double dl = std::hypot(h - lateral[0], r - lateral[1]);
+  const double db = std::hypot(h - base[0], r - base[1]);
+  const bool onLateral = dl <= db;
+  const double* q = onLateral ? lateral : base;
+  const bool atVertex = onLateral ? (t == 0.0 || t == 1.0) : (r >= R);
+  const double D = onLateral ? dl : db;
+  Penetration p;
+  p.depth = -D;
+  if (!(D > 0.0)) return p;
+  const double uh = (h - q[0]) / D, ur = (r - q[1]) / D;  // grad D in (h, r)
+  p.gradient = (d * uh + er * ur) * -1.0;
+  // Hess D = sum of its (h, r) Hessian on (d, er), + ur Hess(r); at a vertex the (h, r)
+  // Hessian is (I - u u^T) / D, along an edge's interior 0.
+  if (atVertex) {
+    const double a = (1.0 - uh * uh) / D, b = -uh * ur / D, c = (1.0 - ur * ur) / D;
+    setOuter(p.hessian, d, d, -a);
+    setOuter(p.hessian, d, er, -b);
+    setOuter(p.hessian, er, d, -b);
+    setOuter(p.hessian, er, er, -c);
+  }
+  if (r > 0.0) {
+    // Hess(r) = (I - d d^T - er er^T) / r.
+    const double k = -ur / r;
+    for (int e = 0; e < 3; ++e) p.hessian[4 * e] += k;
+    setOuter(p.hessian, d, d, -k);
+    setOuter(p.hessian, er, er, -k);
+  }
+  return p;
+}
+
 // Long: the six faces' depths and the nearest one's gradient and Hessian.
 std::optional<Penetration> spiralPenetration(const Spiral& s, const Vec3& x) {
   const double px = x.x - s.cx, py = x.y - s.cy;
@@ -186,10 +228,20 @@ void ObstacleContact::addPenaltyJacobian(const double* x, int n, JacobianBlocks&
   }
 }
 
-int ObstacleContact::penetrations(const Vec3& x, Penetration* out) const {
-  const std::optional<Penetration> q = penetration(x);
-  if (q) out[0] = *q;
-  return q ? 1 : 0;
+int ObstacleContact::penetrations(const Vec3& x, double reach, Penetration* out) const {
+  if (const std::optional<Penetration> q = penetration(x)) {
+    out[0] = *q;
+    return 1;
+  }
+  if (!(reach > 0.0) || !cone_) return 0;
+  out[0] = coneExterior(*cone_, x);
+  return out[0].depth > -reach ? 1 : 0;
+}
+
+double ObstacleContact::signedDistance(const Vec3& x) const {
+  if (const std::optional<Penetration> q = penetration(x)) return -q->depth;
+  if (!cone_) return std::numeric_limits<double>::infinity();
+  return -coneExterior(*cone_, x).depth;
 }
 
 double ObstacleContact::depth(const Vec3& x) const {

@@ -22,6 +22,11 @@ namespace jello {
 // The penetration of point x into a cone or a spiral ramp, or nothing when x is outside.
 std::optional<Penetration> conePenetration(const Cone& cone, const Vec3& x);
 std::optional<Penetration> spiralPenetration(const Spiral& spiral, const Vec3& x);
+// For x outside the cone: its exact distance D to the solid, as a penetration of depth -D (the
+// depth's gradient and Hessian those of -D). In the meridian half-plane (h along the axis from
+// the apex, r from it) the solid is the triangle (0,0), (H,R), (H,0), and D the distance to its
+// lateral edge or its base edge.
+Penetration coneExterior(const Cone& cone, const Vec3& x);
 
 // Penalty contact with one of them (src/effects/obstacle.h has what each method answers); all
 // arrays component-major, n points.
@@ -36,7 +41,9 @@ class ObstacleContact final : public Obstacle {
                         int hi) const override;
   double penaltyEnergy(const double* x, int n) const override;
   void addPenaltyJacobian(const double* x, int n, JacobianBlocks& out) const override;
-  int penetrations(const Vec3& x, Penetration* out) const override;
+  int penetrations(const Vec3& x, double reach, Penetration* out) const override;
+  double signedDistance(const Vec3& x) const override;
+  bool hasExteriorDistance() const override { return cone_.has_value(); }
   double depth(const Vec3& x) const override;
   bool contactBegins(const double* x0, const double* x1, int n) const override;
   int contactSprings(const Vec3& x) const override;

@@ -1,6 +1,7 @@
 // How contact pushes a point out of a solid (src/PHYSICS.md, "Contact models"): the course's
-// penalty, whose stiffness jumps from 0 to kCollision at the surface, or a smooth penalty whose
-// energy is C2 in the depth, so its force and stiffness rise continuously over a thin layer.
+// penalty, whose stiffness jumps from 0 to kCollision at the surface; a smooth penalty whose
+// energy is C2 in the depth, so its force and stiffness rise continuously over a thin layer; or
+// a log barrier in the distance d outside the solid, which no point ever crosses.
 // One table; the world file's `contact` extension, jello-create-world's and jello-sim's
 // `--contact` read and write the names through it.
 #pragma once
@@ -16,7 +17,9 @@ namespace jello {
 #define JELLO_CONTACT_MODELS(X)                                                             \
   X(Penalty, "penalty", "the course's: 1/2 kc depth^2, its stiffness jumps at the surface") \
   X(Smooth, "smooth",                                                                       \
-    "C2 onset over a layer: kc depth^3 / (6 layer), then the penalty shifted by layer / 2")
+    "C2 onset over a layer: kc depth^3 / (6 layer), then the penalty shifted by layer / 2") \
+  X(Barrier, "barrier",                                                                     \
+    "IPC's log barrier: -kappa (d - dhat)^2 ln(d / dhat) within dhat of the surface")
 
 enum class ContactModel {
 #define JELLO_CONTACT_MODEL_ENUMERATOR(kind, name, summary) kind,
@@ -37,10 +40,15 @@ std::string contactModelNames();
 // jello.w).
 inline constexpr double kDefaultContactLayer = 0.005;
 
+// m: the barrier's reach dhat unless a file or flag gives one (the same thinness argument).
+inline constexpr double kDefaultBarrierDistance = 0.005;
+
 // The model and its parameters, as the world file's `contact` extension gives them.
 struct ContactLaw {
   ContactModel model = ContactModel::Penalty;
   double layer = 0.0;  // m, > 0 for smooth: the depth over which stiffness rises to kc
+  double dhat = 0.0;   // m, > 0 for barrier: the distance where the barrier begins
+  double kappa = 0.0;  // N/m, > 0 for barrier: its stiffness scale (default the world's kc)
   bool operator==(const ContactLaw&) const = default;
 };
 

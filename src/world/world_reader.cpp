@@ -113,14 +113,20 @@ void readSpiralExtension(Tokenizer& in, World& world, const ReaderLimits&) {
   world.spiral = s;
 }
 
-// `contact MODEL [parameters]`: penalty takes none, smooth its layer (m, > 0).
+// `contact MODEL [parameters]`: penalty takes none, smooth its layer (m, > 0), barrier its
+// dhat (m, > 0) and kappa (N/m, > 0).
 void readContactExtension(Tokenizer& in, World& world, const ReaderLimits&) {
   const Token name = in.next();
   if (name.text.empty()) in.fail(name, "file ends where a contact model was expected");
   const std::optional<ContactModel> model = contactModelFromName(name.text);
   if (!model) in.fail(name, "unknown contact model (known: " + contactModelNames() + ")");
-  ContactLaw law{*model, 0.0};
+  ContactLaw law;
+  law.model = *model;
   if (law.model == ContactModel::Smooth) law.layer = in.positive("smooth contact layer");
+  if (law.model == ContactModel::Barrier) {
+    law.dhat = in.positive("barrier distance dhat");
+    law.kappa = in.positive("barrier stiffness kappa");
+  }
   world.contact = law;
 }
 

@@ -95,8 +95,10 @@ std::string formatWorld(const World& w, NumberFormat format) {
     extension("spiral", {s.cx, s.cy, s.zTop, s.rInner, s.rOuter, s.pitch, s.turns, s.thickness});
   }
   // Penalty, the course's contact, is what a file without the line means.
-  if (w.contact.model == ContactModel::Smooth) {
-    extension("contact " + std::string(contactModelName(w.contact.model)), {w.contact.layer});
+  const std::string contact = "contact " + std::string(contactModelName(w.contact.model));
+  if (w.contact.model == ContactModel::Smooth) extension(contact, {w.contact.layer});
+  if (w.contact.model == ContactModel::Barrier) {
+    extension(contact, {w.contact.dhat, w.contact.kappa});
   }
   return p.take();
 }

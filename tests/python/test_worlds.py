@@ -102,6 +102,29 @@ def test_contact_model_is_an_attribute_and_a_create_world_keyword(jello_w, tmp_p
         jello.create_world(contact_layer=0.003)
 
 
+def test_the_barrier_has_dhat_and_kappa_and_a_simulation_reports_the_least_distance(jello_w):
+    w = jello_w.copy()
+    w.contact = "barrier"
+    assert (w.dhat, w.kappa) == (0.005, w.k_collision)  # the defaults
+    w.kappa = 600.0
+    assert w.contact_layer == 0.0
+    with pytest.raises(ValueError):
+        jello_w.copy().dhat = 0.01  # penalty has no dhat
+    with pytest.raises(ValueError):
+        w.kappa = 0.0
+    made = jello.create_world(contact="barrier", dhat=0.002, k_collision=900.0)
+    assert (made.contact, made.dhat, made.kappa) == ("barrier", 0.002, 900.0)
+    sim = jello.Simulation(w, integrator="implicit", dt=0.01)
+    sim.run(steps=40)
+    least = sim.stats["min_obstacle_distance_m"]
+    assert 0.0 < least < 0.005
+    # A point inside a solid: the barrier cannot start.
+    inside = w.copy()
+    inside.sphere = (0.5, 0.5, 0.5, 0.3)
+    with pytest.raises(ValueError, match="inside the sphere"):
+        jello.Simulation(inside)
+
+
 def test_cube_resolution_resamples(jello_w):
     w = jello_w.copy()
     w.cube_resolution = 4

@@ -42,6 +42,10 @@ class PySimulation {
              dt ? std::optional(positive(*dt, "dt")) : std::nullopt,
              solverOptionsFrom(options, {})) {
     positive(sim_.dt(), "dt");
+    if (std::string why = sim_.model().contactError(sim_.state().x.data()); !why.empty()) {
+      valueError(why);
+    }
+    sim_.trackObstacleDistance();
     energyStart_ = sim_.model().energy(sim_.state());
     angularStart_ = sim_.model().angularMomentum(sim_.state());
   }
@@ -218,6 +222,8 @@ class PySimulation {
         "angular_momentum_start_kg_m2_per_s"_a = vec3Tuple(angularStart_),
         "angular_momentum_end_kg_m2_per_s"_a = vec3Tuple(L),
         "diverged"_a = sim_.divergence().has_value(), "solver"_a = solver);
+    const std::optional<double> least = sim_.minObstacleDistance();
+    d["min_obstacle_distance_m"] = least ? py::cast(*least) : py::none();
     if (const auto& div = sim_.divergence()) {
       d["divergence"] =
           py::dict("time_s"_a = div->time, "step"_a = div->step, "reason"_a = div->reason);

@@ -96,12 +96,31 @@ void saveWorld(const World& w, const std::string& path, bool legacy) {
 
 namespace {
 
-// The law a model's name gives: smooth keeps a layer already set, else takes the default.
-jello::ContactLaw contactLaw(const std::string& name, double layer) {
+// The law a model's name gives: smooth keeps a layer already set, else takes the default; the
+// barrier keeps its dhat and kappa, else takes kDefaultBarrierDistance and kCollision.
+jello::ContactLaw contactLaw(const std::string& name, const jello::ContactLaw& was,
+                             double kCollision) {
   const std::optional<jello::ContactModel> model = jello::contactModelFromName(name);
   if (!model) valueError("contact must be one of " + jello::contactModelNames());
-  if (*model != jello::ContactModel::Smooth) return {*model, 0.0};
-  return {*model, layer > 0.0 ? layer : jello::kDefaultContactLayer};
+  jello::ContactLaw law;
+  law.model = *model;
+  if (*model == jello::ContactModel::Smooth) {
+    law.layer = was.layer > 0.0 ? was.layer : jello::kDefaultContactLayer;
+  }
+  if (*model == jello::ContactModel::Barrier) {
+    law.dhat = was.dhat > 0.0 ? was.dhat : jello::kDefaultBarrierDistance;
+    law.kappa = was.kappa > 0.0 ? was.kappa : kCollision;
+    if (!(law.kappa > 0.0)) valueError("the barrier's kappa defaults to k_collision, which is 0");
+  }
+  return law;
+}
+
+// Sets a barrier parameter (dhat or kappa), refused for the other models.
+void setBarrierParameter(jello::ContactLaw& law, double& field, double value, const char* name) {
+  if (law.model != jello::ContactModel::Barrier) {
+    valueError(std::string(name) + " applies to the barrier contact model only");
+  }
+  field = positive(value, name);
 }
 
 // Long: one branch per keyword, as jello-create-world's flags.
@@ -109,7 +128,7 @@ jello::ContactLaw contactLaw(const std::string& name, double layer) {
 // that the world reads back.
 World createWorld(const py::kwargs& kwargs) {
   jello::SceneSpec spec;
-  std::optional<double> fieldStrength, contactLayer;
+  std::optional<double> fieldStrength, contactLayer, dhat, kappa;
   for (const auto& [key, value] : kwargs) {
     const std::string name = py::cast<std::string>(key);
     const char* n = name.c_str();
@@ -131,9 +150,13 @@ World createWorld(const py::kwargs& kwargs) {
     } else if (name == "mass") {
       spec.mass = positive(real(), n);
     } else if (name == "contact") {
-      spec.contact = contactLaw(as<std::string>(value, name), spec.contact.layer);
+      spec.contact.model = contactLaw(as<std::string>(value, name), {}, 1.0).model;
     } else if (name == "contact_layer") {
       contactLayer = positive(real(), n);
+    } else if (name == "dhat") {
+      dhat = positive(real(), n);
+    } else if (name == "kappa") {
+      kappa = positive(real(), n);
     } else if (name == "plane") {
       if (value.is_none()) {
         spec.plane.reset();
@@ -204,15 +227,20 @@ World createWorld(const py::kwargs& kwargs) {
                  "' (known: integrator, dt, steps_per_frame, k_elastic, d_elastic, k_collision, "
                  "d_collision, mass, plane, field, field_strength, field_resolution, pose, "
                  "stretch, rotate, axis, translate, velocity, spin, sphere, cube, contact, "
-                 "contact_layer)");
+                 "contact_layer, dhat, kappa)");
     }
   }
+  // The model's parameters once every keyword is read (k_collision may come after contact).
+  const jello::ContactModel model = spec.contact.model;
+  spec.contact = contactLaw(std::string(jello::contactModelName(model)), {}, spec.kCollision);
   if (contactLayer) {
-    if (spec.contact.model != jello::ContactModel::Smooth) {
+    if (model != jello::ContactModel::Smooth) {
       valueError("contact_layer applies to the smooth contact model only");
     }
     spec.contact.layer = *contactLayer;
   }
+  if (dhat) setBarrierParameter(spec.contact, spec.contact.dhat, *dhat, "dhat");
+  if (kappa) setBarrierParameter(spec.contact, spec.contact.kappa, *kappa, "kappa");
   spec.fieldStrength = fieldStrength.value_or(jello::defaultFieldStrength(spec.field, spec.mass));
   const World world = jello::buildWorld(spec);
   try {
@@ -264,8 +292,11 @@ void bindWorlds(py::module_& m) {
       .def_property(
           "contact",
           [](const World& w) { return std::string(jello::contactModelName(w.contact.model)); },
-          [](World& w, const std::string& name) { w.contact = contactLaw(name, w.contact.layer); },
-          "contact model: penalty (the course's) or smooth (stiffening over contact_layer)")
+          [](World& w, const std::string& name) {
+            w.contact = contactLaw(name, w.contact, w.kCollision);
+          },
+          "contact model: penalty (the course's), smooth (stiffening over contact_layer) or "
+          "barrier (a log barrier within dhat of every solid, stiffness scale kappa)")
       .def_property(
           "contact_layer", [](const World& w) { return w.contact.layer; },
           [](World& w, double layer) {
@@ -274,7 +305,15 @@ void bindWorlds(py::module_& m) {
             }
             w.contact.layer = positive(layer, "contact_layer");
           },
-          "the smooth contact model's layer, m (0 for penalty)")
+          "the smooth contact model's layer, m (0 for the others)")
+      .def_property(
+          "dhat", [](const World& w) { return w.contact.dhat; },
+          [](World& w, double v) { setBarrierParameter(w.contact, w.contact.dhat, v, "dhat"); },
+          "the barrier's reach, m (0 for the other models)")
+      .def_property(
+          "kappa", [](const World& w) { return w.contact.kappa; },
+          [](World& w, double v) { setBarrierParameter(w.contact, w.contact.kappa, v, "kappa"); },
+          "the barrier's stiffness scale, N/m (0 for the other models)")
       .def_property(
           "mass", [](const World& w) { return w.mass; },
           [](World& w, double v) { w.mass = positive(v, "mass"); }, "mass of each point, kg")
