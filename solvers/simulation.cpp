@@ -81,7 +81,7 @@ std::optional<std::string> Simulation::energyGrowth() {
   os << "the energy grew to " << now << " J (energy bound " << kEnergyGrowthFactor << " x its "
      << (swings ? "envelope " : "start's ") << energyEnvelope_ << " J";
   if (swings) os << ", the largest of its first " << kEnergyEnvelopeSteps << " steps";
-  os << ", + " << kEnergyFloor << " J, net of the field's and the user force's work)";
+  os << ", + " << kEnergyFloor << " J, net of the field's, the user force's and friction's work)";
   return os.str();
 }
 
@@ -171,6 +171,7 @@ StepResult Simulation::step() {
     // The work of the forces no potential describes, only for scenes that have them.
     if (model_.hasField()) fieldWork_ += model_.fieldWork(previous_.x.data(), state_.x.data());
     if (model_.hasUserForce()) userWork_ += model_.userForceWork(previous_.x, state_.x);
+    if (model_.hasFriction()) frictionWork_ += model_.frictionWork(previous_, state_);
     if (steps_ - envelopeStart_ <= kEnergyEnvelopeSteps || steps_ % kEnergyCheckInterval == 0) {
       broken = energyGrowth();
     }

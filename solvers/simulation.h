@@ -19,8 +19,8 @@ namespace jello {
 // kDivergenceBound from the origin (m: the box is [-2,2]^3, so no sane state comes near it).
 inline constexpr double kDivergenceBound = kStartBound;
 // A run has diverged, too, when its energy has grown: kinetic + spring + contact energy minus
-// the work the field and the user force have done exceeds the budget, kEnergyGrowthFactor times
-// its envelope plus kEnergyFloor (J, so that a cube starting at rest is not flagged by
+// the work the field, the user force and friction have done exceeds the budget, kEnergyGrowthFactor
+// times its envelope plus kEnergyFloor (J, so that a cube starting at rest is not flagged by
 // round-off), the same rule as the stability experiment's blow-up rule. For the explicit
 // methods (isExplicit) the envelope is the largest energy of the first kEnergyEnvelopeSteps
 // steps (from the start or an edit), not the start's: a bounded oscillation's energy swings
@@ -96,6 +96,10 @@ class Simulation {
   // energy balance, so kinetic + spring + contact - work is what damping alone changes.
   double fieldWork() const { return fieldWork_; }
   double userForceWork() const { return userWork_; }
+  // Work (J, <= 0) friction has done since the start (Model::frictionWork, step by step): minus
+  // it is what friction dissipated, which the energy rule counts beside the energy, so an
+  // integrator's gain is not hidden by friction's loss.
+  double frictionWork() const { return frictionWork_; }
 
   // The world with the current state as its initial state (what --out saves).
   World currentWorld() const;
@@ -124,9 +128,10 @@ class Simulation {
   long envelopeStart_ = 0;
   double fieldWork_ = 0.0;
   double userWork_ = 0.0;
+  double frictionWork_ = 0.0;
   bool trackDistance_ = false;
   double minDistance_ = 0.0;
-  double externalWork() const { return fieldWork_ + userWork_; }
+  double externalWork() const { return fieldWork_ + userWork_ + frictionWork_; }
   std::optional<std::string> energyGrowth();
   // The barrier's rule (no point at or inside a solid) and the tracked least distance.
   std::optional<std::string> obstacleDistance();

@@ -15,8 +15,9 @@ ModelSpec modelSpecFromWorld(const World& world) {
   spec.numPoints = lattice.numPoints();
   spec.mass = world.mass;
   spec.springs = latticeSpringGroups(lattice, world.kElastic, world.dElastic);
-  spec.contact = {world.kCollision,    world.dCollision,   world.contact.model,
-                  world.contact.layer, world.contact.dhat, world.contact.kappa};
+  spec.contact = {world.kCollision,    world.dCollision,       world.contact.model,
+                  world.contact.layer, world.contact.dhat,     world.contact.kappa,
+                  world.contact.mu,    world.contact.slipSpeed};
   spec.plane = world.plane;
   spec.sphere = world.sphere;
   spec.cone = world.cone;
@@ -45,6 +46,7 @@ Model::Model(ModelSpec spec)
   if (spec.spiral) {
     obstacles_.push_back(std::make_unique<ObstacleContact>(*spec.spiral, spec.contact));
   }
+  friction_ = spec.contact.mu > 0.0 && !obstacles_.empty();
   if (!spec.field.empty()) {
     FieldForces field(std::move(spec.field));
     if (!field.isZero()) field_.emplace(std::move(field));
@@ -64,6 +66,7 @@ unsigned Model::addPointForces(const double* x, const double* v, double* f, int 
   unsigned evaluated = 0;
   for (std::size_t i = 0; i < obstacles_.size(); ++i) {
     if (obstacles_[i]->addForces(x, v, f, n, lo, hi)) evaluated |= 1u << i;
+    if (friction_) obstacles_[i]->addFrictionForces(frictionAt_ ? frictionAt_ : x, v, f, n, lo, hi);
   }
   if (field_) field_->accumulate(x, f, n, lo, hi);
   if (userForce_) {
@@ -157,7 +160,12 @@ void Model::acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
 
 void Model::addJacobian(const double* x, JacobianBlocks& out) const {
   springs_.addJacobian(x, out);
-  for (const auto& o : obstacles_) o->addJacobian(x, n_, out);
+  for (const auto& o : obstacles_) {
+    o->addJacobian(x, n_, out);
+    if (friction_ && out.velocities) {
+      o->addFrictionJacobian(frictionAt_ ? frictionAt_ : x, out.velocities, n_, out);
+    }
+  }
   if (field_) field_->addJacobian(x, n_, out);
 }
 
@@ -177,6 +185,27 @@ bool Model::inContact(const double* x) const {
     }
   }
   return false;
+}
+
+bool Model::hasFriction() const {
+  return friction_;
+}
+
+double Model::frictionPotential(const double* x, const double* v) const {
+  if (!friction_) return 0.0;
+  double potential = 0.0;
+  for (const auto& o : obstacles_)
+    potential += o->frictionPotential(frictionAt_ ? frictionAt_ : x, v, n_);
+  return potential;
+}
+
+double Model::frictionWork(const State& from, const State& to) const {
+  double power0 = 0.0, power1 = 0.0;
+  for (const auto& o : obstacles_) {
+    power0 += o->frictionPower(from.x.data(), from.v.data(), n_);
+    power1 += o->frictionPower(to.x.data(), to.v.data(), n_);
+  }
+  return 0.5 * (power0 + power1) * (to.t - from.t);
 }
 
 bool Model::barrierContact() const {

@@ -116,6 +116,31 @@ class Model {
   // trapezoid rule along the straight path: sum of 1/2 (F(x0) + F(x1)) . (x1 - x0). Exact for
   // a uniform field; 0 without a field.
   double fieldWork(const double* x0, const double* x1) const;
+  // True when contact has Coulomb friction (mu > 0).
+  bool hasFriction() const;
+  // While one lives, friction's normal forces and normals (Obstacle::addFrictionForces) come
+  // from positions x (3n, alive as long) instead of each evaluated state's: the implicit
+  // methods lag them at their step's start (IPC), so that within the step friction is the
+  // gradient of a dissipation potential in v and Newton converges on it (lagged per iterate,
+  // the normal force's pull on the slip, left out of K, made Newton creep: 100+ iterations a
+  // step on a cube resting on a slope). One at a time per model; the explicit methods and
+  // cvode evaluate friction at each state.
+  class FrictionLag {
+   public:
+    FrictionLag(const Model& model, const double* x) : model_(model) { model_.frictionAt_ = x; }
+    ~FrictionLag() { model_.frictionAt_ = nullptr; }
+    FrictionLag(const FrictionLag&) = delete;
+    FrictionLag& operator=(const FrictionLag&) = delete;
+
+   private:
+    const Model& model_;
+  };
+  // Friction's dissipation potential (W) at velocities v, lambda and n from positions x or the
+  // lag (Obstacle::frictionPotential): with the lag, the force is minus its gradient in v.
+  double frictionPotential(const double* x, const double* v) const;
+  // Work (J) friction does over a step of h from (x0, v0) to (x1, v1), by the trapezoid rule on
+  // its power (Obstacle::frictionPower): <= 0, what it dissipated; 0 without friction.
+  double frictionWork(const State& from, const State& to) const;
   // Work (J) of the user force (constant) over the move from x0 to x1; 0 without one.
   double userForceWork(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1) const;
 
@@ -176,6 +201,8 @@ class Model {
   std::vector<std::unique_ptr<Obstacle>> obstacles_;
   std::optional<FieldForces> field_;
   std::optional<Eigen::VectorXd> userForce_;
+  bool friction_ = false;
+  mutable const double* frictionAt_ = nullptr;  // FrictionLag's positions, or none
   struct Counters {
     std::atomic<long> springs{0}, field{0}, user{0};
     std::array<std::atomic<long>, kObstacleKinds> obstacles{}, skipped{};

@@ -517,6 +517,38 @@ TEST(Contact, FlagsChooseTheModelInBothToolsAndBadOnesAreRefused) {
       << spiral.output;
 }
 
+// Friction: --friction MU and --slip-speed in both tools (jello-sim's over the file's), with any
+// contact model; the statistics report mu and the work friction did (negative: dissipated).
+TEST(Contact, FrictionFlagsSetMuAndTheSlipSpeedAndTheStatsCountItsWork) {
+  test::TempDir dir;
+  const auto out = dir.path() / "w.w", bad = dir.path() / "bad.w", stats = dir.path() / "s.json";
+  ASSERT_EQ(run(create() + " -o " + out.string() + " --friction 0.4 --slip-speed 0.002").code, 0);
+  ContactLaw expected;
+  expected.mu = 0.4;
+  expected.slipSpeed = 0.002;
+  EXPECT_EQ(readWorld(out).contact, expected);
+  EXPECT_EQ(run(create() + " -o " + bad.string() + " --slip-speed 0.002").code, 2);
+  EXPECT_EQ(run(create() + " -o " + bad.string() + " --friction -1").code, 2);
+  EXPECT_FALSE(std::filesystem::exists(bad));
+  const auto friction = [&](const std::string& file, const std::string& flags) {
+    const Outcome r = run(sim() + " " + file + " --integrator implicit --dt 0.01 --steps 60 " +
+                          "--quiet --stats " + stats.string() + " " + flags);
+    EXPECT_EQ(r.code, 0) << r.output;
+    std::ifstream in(stats);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    return std::make_pair(j["contact"]["friction_mu"].get<double>(),
+                          j["contact"]["friction_work_J"].get<double>());
+  };
+  const auto [mu, work] = friction(out.string(), "");
+  EXPECT_EQ(mu, 0.4);
+  EXPECT_LT(work, 0.0);  // jello.w's cube hits the walls within 0.6 s
+  EXPECT_EQ(friction(out.string(), "--friction 0"), std::make_pair(0.0, 0.0));
+  EXPECT_EQ(friction(world("jello.w"), "--friction 0.7 --contact smooth").first, 0.7);
+  const Outcome lone = run(sim() + " " + world("jello.w") + " --steps 1 --slip-speed 0.01");
+  EXPECT_EQ(lone.code, 2);
+  EXPECT_TRUE(contains(lone.output, "--slip-speed applies with friction only")) << lone.output;
+}
+
 // #16: --stats /dev/stdout works (the link is followed to the pipe and written in place), and
 // --out to a device leaves the device a device. Private stand-ins, never the machine's own
 // /dev/stdout or /dev/null: a writer that regressed would replace them.

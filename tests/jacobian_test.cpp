@@ -242,7 +242,7 @@ TEST(ImplicitSystem, SolvesTheMassMinusScaledJacobiansAtTheAssembledState) {
     ImplicitSystem system(options, true);
     EXPECT_TRUE(system.bind(model));
     EXPECT_FALSE(system.bind(model));
-    system.assemble(s.x.data());
+    system.assemble(s.x.data(), s.v.data());
     const double a = 0.02, b = 4e-4;
     ASSERT_TRUE(system.factorize(a, b).ok);
     const Eigen::Index n3 = s.x.size();

@@ -158,6 +158,7 @@ void Panel::syncFromWorld(const Frame& frame) {
   if (w.contact.layer > 0.0) contactLayer_ = static_cast<float>(w.contact.layer);
   if (w.contact.dhat > 0.0) dhat_ = static_cast<float>(w.contact.dhat);
   kappa_ = static_cast<float>(w.contact.kappa > 0.0 ? w.contact.kappa : w.kCollision);
+  mu_ = static_cast<float>(w.contact.mu);
   mass_ = static_cast<float>(w.mass);
   dt_ = static_cast<float>(frame.dt);
   if (w.plane) savedPlane_ = w.plane;
@@ -191,12 +192,15 @@ void Panel::constants(const Frame& frame, SimRunner& runner) {
     contactChanged |= logSlider("dhat (m)", &dhat_, 1e-4f, 0.1f, "%.3g");
     contactChanged |= logSlider("kappa (N/m)", &kappa_, 1.0f, 1e6f, "%.4g");
   }
+  // Coulomb friction on every solid (0: none, the course's).
+  contactChanged |= ImGui::SliderFloat("friction mu", &mu_, 0.0f, 2.0f, "%.2f");
   if (contactChanged) {
     // A barrier asked for with points inside a solid stops the simulation with the reason.
     const bool barrier = contact_.model == ContactModel::Barrier;
     contact_.layer = contact_.model == ContactModel::Smooth ? double(contactLayer_) : 0.0;
     contact_.dhat = barrier ? double(dhat_) : 0.0;
     contact_.kappa = barrier ? double(kappa_) : 0.0;
+    contact_.mu = std::max(0.0, double(mu_));  // ctrl-click can type any number
     edit([law = contact_](World& w) { w.contact = law; });
   }
   if (logSlider("mass (kg)", &mass_, 1e-5f, 1.0f, "%.3g")) {

@@ -73,6 +73,7 @@ class Panel {
   float contactLayer_ = float(kDefaultContactLayer);
   float dhat_ = float(kDefaultBarrierDistance);
   float kappa_ = 400.0f;  // N/m: the world's kCollision until it is synced
+  float mu_ = 0.0f;
   float dt_ = 0;
   float pullScale_ = 1;
   SolverOptions options_;  // the solver section's copy while editing

@@ -30,6 +30,7 @@ EnergyReport energyReport(const Simulation& sim) {
   r.contact = e.contact;
   r.field = 0.0 - sim.fieldWork();  // 0 - 0 is +0: no "-0" in the heads-up
   r.user = 0.0 - sim.userForceWork();
+  r.friction = 0.0 - sim.frictionWork();
   return r;
 }
 

@@ -29,11 +29,12 @@ namespace jello::viewer {
 
 inline constexpr double kMaxBacklog = 0.25;  // wall seconds of simulated time owed at most
 
-// The energy the heads-up and the panel show, J: the field's and the user force's share is
-// minus the work they did since the start, so `total` changes only by damping.
+// The energy the heads-up and the panel show, J: the field's, the user force's and friction's
+// share is minus the work they did since the start (friction's: what it dissipated), so
+// `total` changes only by damping.
 struct EnergyReport {
-  double kinetic = 0.0, spring = 0.0, contact = 0.0, field = 0.0, user = 0.0;
-  double total() const { return kinetic + spring + contact + field + user; }
+  double kinetic = 0.0, spring = 0.0, contact = 0.0, field = 0.0, user = 0.0, friction = 0.0;
+  double total() const { return kinetic + spring + contact + field + user + friction; }
 };
 EnergyReport energyReport(const Simulation& sim);
 

@@ -26,6 +26,14 @@ void addContactFlags(CLI::App& app, ContactFlags& flags, const std::string& what
   app.add_option("--kappa", flags.kappa,
                  "The barrier's stiffness scale, N/m (default the world's kCollision)")
       ->check(cli::positive());
+  app.add_option("--friction", flags.mu,
+                 "Coulomb friction's coefficient mu on every solid (default 0: none)")
+      ->check(cli::nonNegative());
+  app.add_option("--slip-speed", flags.slipSpeed,
+                 "Friction's slip speed, m/s: below it friction is static, a stiff damper "
+                 "(default " +
+                     number(kDefaultSlipSpeed) + ")")
+      ->check(cli::positive());
 }
 
 std::string applyContactFlags(const ContactFlags& flags, ContactLaw& law, double kCollision) {
@@ -50,6 +58,11 @@ std::string applyContactFlags(const ContactFlags& flags, ContactLaw& law, double
   law.kappa = barrier ? flags.kappa.value_or(law.kappa > 0.0 ? law.kappa : kCollision) : 0.0;
   if (barrier && !(law.kappa > 0.0)) {
     return "the barrier's kappa defaults to kCollision, which is 0 here: give --kappa";
+  }
+  if (flags.mu) law.mu = *flags.mu;
+  if (flags.slipSpeed) {
+    if (!(law.mu > 0.0)) return "--slip-speed applies with friction only (give --friction)";
+    law.slipSpeed = *flags.slipSpeed;
   }
   return "";
 }

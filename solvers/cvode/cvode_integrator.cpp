@@ -322,7 +322,7 @@ int CvodeIntegrator::linearSystem(const double* y, bool jacobianOk, bool* jacobi
                                   double gamma) {
   if (!jacobianOk || !assembled_) {
     x_ = Eigen::Map<const Eigen::VectorXd>(y, n3_) + shift_;
-    system_.assemble(x_.data());
+    system_.assemble(x_.data(), y + n3_);
     assembled_ = true;
     *jacobianCurrent = true;
   }

@@ -40,9 +40,12 @@ void LinearizedBackwardEuler::keepOutside(const Model& model, const State& s, do
 
 StepResult LinearizedBackwardEuler::step(const Model& model, State& s, double h) {
   prepare(model);
+  // Friction's normal forces at the step's start, as the Newton methods take them.
+  const Eigen::VectorXd lagged = model.hasFriction() ? s.x : Eigen::VectorXd();
+  const Model::FrictionLag lag(model, model.hasFriction() ? lagged.data() : nullptr);
   model.forces(s.x, s.v, f_);
   // First iteration, linearized at (x0, v0): rhs = h (f0 + h K v0).
-  system_.assemble(s.x.data());
+  system_.assemble(s.x.data(), s.v.data());
   rhs_.noalias() = system_.K() * s.v;
   rhs_ = h * (f_ + h * rhs_);
   // dv_ still holds the last step's dv: a good first guess for CG.
@@ -70,7 +73,7 @@ StepResult LinearizedBackwardEuler::step(const Model& model, State& s, double h)
         break;
       }
       rhs_ = -g_;
-      system_.assemble(x1_.data());
+      system_.assemble(x1_.data(), v1_.data());
       delta_.setZero(rhs_.size());  // a correction: small, so start CG from zero
       if (StepResult r = factorAndSolve(h, rhs_, delta_); !r.ok) return r;
       v1_ += delta_;

@@ -74,7 +74,12 @@ double NewtonIntegrator::merit(const Model& model, double inertia, const Eigen::
   ve_ = form.sigma * d + form.vConst;
   e += (model.potentialEnergy(xe_.data()) - external_.dot(xe_)) / form.theta;
   dv_.noalias() = system_.D() * ve_;
-  e += -0.5 * ve_.dot(dv_) / form.sigma;
+  // Friction by its dissipation potential (convex in v; lambda and n lagged at the step's
+  // start), not by the quadratic of its D at the iterate, which is flat along a slip above
+  // eps_v: there the line search could not see friction at all.
+  e += (-0.5 * (ve_.dot(dv_) - system_.frictionQuadratic(ve_.data())) +
+        model.frictionPotential(xe_.data(), ve_.data())) /
+       form.sigma;
   return e;
 }
 
@@ -85,7 +90,7 @@ std::pair<double, double> NewtonIntegrator::matrixCoefficients(double h) const {
 }
 
 StepResult NewtonIntegrator::prepareNewtonMatrix(double h, bool refactor) {
-  system_.assemble(xe_.data());
+  system_.assemble(xe_.data(), ve_.data());
   const auto [a, b] = matrixCoefficients(h);
   if (!refactor && factorValid_ && a == factorA_ && b == factorB_) {
     ++reuses_;
@@ -190,6 +195,7 @@ StepResult NewtonIntegrator::advance(const Model& model, State& s, double h, int
 // Leaves the displacement in d_ and the form in form_; s is not changed.
 StepResult NewtonIntegrator::solve(const Model& model, const State& s, double h, bool& converged,
                                    int& iterations) {
+  const Model::FrictionLag lag(model, s.x.data());  // friction's normal forces at the start
   this->form(model, s, h, form_);
   const ImplicitStepForm& form = form_;
   const double inertia = form.gamma / (h * h);  // r = gamma m/h^2 (d - d_pred) - f
@@ -293,6 +299,7 @@ StepResult NewtonIntegrator::solve(const Model& model, const State& s, double h,
 Eigen::VectorXd NewtonIntegrator::residual(const Model& model, const State& start, double h,
                                            const Eigen::VectorXd& y) {
   bind(model);
+  const Model::FrictionLag lag(model, start.x.data());
   form(model, start, h, form_);
   evaluate(model, form_.gamma / (h * h), y - start.x);
   return r_;
@@ -301,9 +308,10 @@ Eigen::VectorXd NewtonIntegrator::residual(const Model& model, const State& star
 SparseMatrix NewtonIntegrator::newtonMatrix(const Model& model, const State& start, double h,
                                             const Eigen::VectorXd& y) {
   bind(model);
+  const Model::FrictionLag lag(model, start.x.data());
   form(model, start, h, form_);
   evaluate(model, form_.gamma / (h * h), y - start.x);
-  system_.assemble(xe_.data());
+  system_.assemble(xe_.data(), ve_.data());
   const auto [a, b] = matrixCoefficients(h);
   system_.formMatrix(a, b);
   factorValid_ = false;  // A now differs from what was factored

@@ -46,10 +46,10 @@ bool ImplicitSystem::bind(const Model& model) {
   return true;
 }
 
-void ImplicitSystem::assemble(const double* x) {
+void ImplicitSystem::assemble(const double* x, const double* v) {
   JELLO_ASSERT(bound(), "the implicit system is bound to a model before it assembles");
   const auto start = std::chrono::steady_clock::now();
-  jacobian_->assemble(x, {clampCompression_, false});
+  jacobian_->assemble(x, {clampCompression_, false, v});
   if (solver_.kind() == LinearSolverKind::Cg &&
       solver_.preconditioner() == PreconditionerKind::Projective) {
     x_ = Eigen::Map<const Eigen::VectorXd>(x, 3 * static_cast<Eigen::Index>(model_->numPoints()));

@@ -36,8 +36,9 @@ class ImplicitSystem {
   bool bind(const Model& model);
   bool bound() const { return jacobian_ != nullptr; }
 
-  // K and D at positions x (3n): the last assembly until the next.
-  void assemble(const double* x);
+  // K and D at positions x and velocities v (3n each; v: friction's D, src/effects/obstacle.h,
+  // left out when null): the last assembly until the next.
+  void assemble(const double* x, const double* v);
   // A = M - a D - b K of the last assembly, written into A().
   void formMatrix(double a, double b);
   // A as formed, factored (CHOLMOD) or prepared (CG: the preconditioner set up and, matrix-free,
@@ -60,6 +61,7 @@ class ImplicitSystem {
 
   const SparseMatrix& K() const { return jacobian_->K(); }
   const SparseMatrix& D() const { return jacobian_->D(); }
+  double frictionQuadratic(const double* v) const { return jacobian_->frictionQuadratic(v); }
   const SparseMatrix& A() const { return A_; }
   const SpdSolver& solver() const { return solver_; }
   long clampCount() const { return jacobian_ ? jacobian_->totalClampCount() : 0; }

@@ -81,7 +81,12 @@ void JacobianAssembler::assemble(const double* x, const JacobianOptions& options
   blocks.springSlots = springSlots_.data();
   blocks.clampCompression = options.clampCompression;
   blocks.includeField = options.includeField;
+  blocks.velocities = options.velocities;
+  const bool friction = options.velocities && model_.hasFriction();
+  diagFriction_.assign(friction ? diagD_.size() : 0, 0.0);
+  if (friction) blocks.diagFriction = diagFriction_.data();
   model_.addJacobian(x, blocks);
+  for (std::size_t i = 0; i < diagFriction_.size(); ++i) diagD_[i] += diagFriction_[i];
   lastClamps_ = blocks.clamps;
   totalClamps_ += blocks.clamps;
   for (std::size_t i = 0; i < diagSlots_.size(); ++i) {
@@ -90,6 +95,19 @@ void JacobianAssembler::assemble(const double* x, const JacobianOptions& options
   }
   JELLO_VALIDATE(options.includeField || isSymmetric(K_), "K is symmetric without the field");
   JELLO_VALIDATE(isSymmetric(D_), "D is symmetric");
+}
+
+double JacobianAssembler::frictionQuadratic(const double* v) const {
+  if (diagFriction_.empty()) return 0.0;
+  const std::ptrdiff_t n = model_.numPoints();
+  double sum = 0.0;
+  for (std::ptrdiff_t p = 0; p < n; ++p) {
+    const double* B = diagFriction_.data() + 9 * p;
+    const double u[3] = {v[p], v[n + p], v[2 * n + p]};
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) sum += u[r] * B[3 * r + c] * u[c];
+  }
+  return sum;
 }
 
 void JacobianAssembler::combine(double alpha, double beta, SparseMatrix& A) const {

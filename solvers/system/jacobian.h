@@ -22,18 +22,24 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 struct JacobianOptions {
   bool clampCompression = true;
   bool includeField = false;  // the field's gradient is not symmetric: not for Cholesky
+  // The velocities (3n) friction's D is evaluated at: the one term of D that depends on v
+  // (null: friction is left out of D).
+  const double* velocities = nullptr;
 };
 
 class JacobianAssembler {
  public:
   explicit JacobianAssembler(const Model& model);
 
-  // Refills K and D at positions x, 3n component-major (the forces are linear in v: D does not
-  // depend on it).
+  // Refills K and D at positions x, 3n component-major (every force but friction is linear in
+  // v: friction's D is evaluated at options.velocities).
   void assemble(const double* x, const JacobianOptions& options);
 
   const SparseMatrix& K() const { return K_; }
   const SparseMatrix& D() const { return D_; }
+  // v^T D_f v for friction's part D_f of the last assembly's D (0 without friction): what
+  // Newton's merit takes out of its damping term to weigh friction by its own potential.
+  double frictionQuadratic(const double* v) const;
 
   // A = mass I - alpha D - beta K, written into A's values. A must have the pattern of K (use
   // pattern() to make one); the values are combined array-wise.
@@ -55,6 +61,7 @@ class JacobianAssembler {
   std::vector<int> springSlots_;       // 18 per spring: value index of blocks (a,b), (b,a)
   std::vector<int> diagSlots_;         // 9 per point: value index of its diagonal block
   std::vector<double> diagK_, diagD_;  // 9 per point: diagonal blocks gathered densely
+  std::vector<double> diagFriction_;   // 9 per point: friction's part of diagD_, or empty
   std::vector<int> diagonal_;          // value index of each diagonal entry (for the mass)
   long lastClamps_ = 0, totalClamps_ = 0;
 };

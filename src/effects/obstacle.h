@@ -50,10 +50,22 @@ struct ContactConstants {
   double stiffness = 0.0;  // N/m (kCollision)
   double damping = 0.0;    // N*s/m (dCollision)
   ContactModel model = ContactModel::Penalty;
-  double layer = 0.0;  // m, the smooth law's layer
-  double dhat = 0.0;   // m, the barrier's reach
-  double kappa = 0.0;  // N/m, the barrier's stiffness scale
+  double layer = 0.0;      // m, the smooth law's layer
+  double dhat = 0.0;       // m, the barrier's reach
+  double kappa = 0.0;      // N/m, the barrier's stiffness scale
+  double mu = 0.0;         // Coulomb friction's coefficient; 0: none
+  double slipSpeed = 0.0;  // m/s, eps_v: where static friction has turned kinetic
 };
+
+// Coulomb friction smoothed over the slip speed eps (IPC's mollifier, src/PHYSICS.md) at slip
+// speed s = |u|, u the tangential velocity: f1(s) = 2 s/eps - s^2/eps^2 below eps, 1 above,
+// so the force -mu lambda f1(s) u/s grows from 0 like a stiff damper (static friction) to
+// Coulomb's mu lambda; g = f1/s and g' its derivative in s (the force is -mu lambda g u, its
+// velocity Jacobian -mu lambda (g T + g' u u^T/s), T = I - n n^T).
+struct FrictionValue {
+  double f1 = 0.0, g = 0.0, dg = 0.0;
+};
+FrictionValue smoothedFriction(double slip, double slipSpeed);
 
 // A contact's depth e(q) law at depth q > 0: energy (J), its first derivative (N: the force's
 // magnitude along the depth's gradient) and second (N/m: the stiffness along it).
@@ -104,7 +116,7 @@ class Obstacle {
   }
   // K = df/dx and D = df/dv on each touching point's diagonal block (src/effects/
   // jacobian_blocks.h): K = -(e'' g g^T + e' Hess(q)), D = -dc w n n^T; the curvature term
-  // e' Hess(q) is dropped under the clamp.
+  // e' Hess(q) is dropped under the clamp; friction's D where out gives the velocities.
   void addJacobian(const double* x, int n, JacobianBlocks& out) const {
     if (k_.model == ContactModel::Penalty) {
       addPenaltyJacobian(x, n, out);
@@ -112,6 +124,20 @@ class Obstacle {
       addLawJacobian(x, n, out);
     }
   }
+  // Friction (src/effects/friction.cpp): on each contact with normal force lambda > 0 (the
+  // law's elastic part e'(q), no damping), normal n and tangential velocity u = (I - n n^T) v,
+  //   f = -mu lambda f1(|u|) u/|u|,   D = df/dv = -mu lambda (g T + g' u u^T/|u|),
+  // D symmetric and negative semidefinite. lambda and n come from positions `at` (3n): the
+  // state's own, or where the model lags them (Model::FrictionLag); their derivatives in x are
+  // never in K. Nothing without friction (mu = 0).
+  void addFrictionForces(const double* at, const double* v, double* f, int n, int lo, int hi) const;
+  void addFrictionJacobian(const double* at, const double* v, int n, JacobianBlocks& out) const;
+  // Friction's power, sum f.v over all n points (W, <= 0): the rate at which it dissipates.
+  double frictionPower(const double* x, const double* v, int n) const;
+  // Friction's dissipation potential (W) with lambda and n from positions x: sum of
+  // mu lambda F0(|u|), F0' = f1 (s^2/eps - s^3/(3 eps^2), then s - eps/3), so f = -dF/dv; convex.
+  double frictionPotential(const double* x, const double* v, int n) const;
+
   // Writes each contact x has with this solid (at most kMaxPenetrations) to out; returns how
   // many. With reach > 0 also those outside, within reach of the surface: their depth is minus
   // their exact distance to it (the spiral has none: it has no exterior distance yet).
@@ -176,6 +202,15 @@ class Obstacle {
  private:
   // The law's value at depth q (not the penalty's, which has its own loops).
   ContactLawValue law(double depth) const;
+  struct FrictionContact {
+    double bound = 0.0;  // N: mu lambda
+    Vec3 normal;
+    Vec3 slip;  // m/s: u
+  };
+  // The friction contacts of point p at (x, v), written to out; how many.
+  int frictionContacts(const double* x, const double* v, int n, int p, FrictionContact* out) const;
+  // The elastic normal force's magnitude (N) of a contact at depth q under the scene's law.
+  double normalForce(double depth) const;
   double dampingWeight(const ContactLawValue& e) const;
   bool addLawForces(const double* x, const double* v, double* f, int n, int lo, int hi) const;
   double lawEnergy(const double* x, int n) const;

@@ -43,13 +43,21 @@ inline constexpr double kDefaultContactLayer = 0.005;
 // m: the barrier's reach dhat unless a file or flag gives one (the same thinness argument).
 inline constexpr double kDefaultBarrierDistance = 0.005;
 
-// The model and its parameters, as the world file's `contact` extension gives them.
+// m/s: the slip speed over which friction rises from 0 to mu times the normal force.
+inline constexpr double kDefaultSlipSpeed = 0.001;
+
+// The model and its parameters, as the world file's `contact` extension gives them, and
+// Coulomb friction (the `friction` extension; mu = 0: none, as the course has).
 struct ContactLaw {
   ContactModel model = ContactModel::Penalty;
   double layer = 0.0;  // m, > 0 for smooth: the depth over which stiffness rises to kc
   double dhat = 0.0;   // m, > 0 for barrier: the distance where the barrier begins
   double kappa = 0.0;  // N/m, > 0 for barrier: its stiffness scale (default the world's kc)
+  double mu = 0.0;     // Coulomb's coefficient, >= 0
+  double slipSpeed = kDefaultSlipSpeed;  // m/s, > 0: eps_v, where static turns kinetic
   bool operator==(const ContactLaw&) const = default;
+  // False when the file needs the `friction` extension to say mu and eps_v.
+  bool frictionIsDefault() const { return mu == 0.0 && slipSpeed == kDefaultSlipSpeed; }
 };
 
 }  // namespace jello

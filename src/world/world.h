@@ -93,6 +93,7 @@ struct World {
   bool usesExtensions() const {
     return cubeResolution != kDefaultCubeResolution || sphere.has_value() || cone.has_value() ||
            spiral.has_value() || contact.model != ContactModel::Penalty ||
+           !contact.frictionIsDefault() ||
            (integrator != IntegratorKind::Euler && integrator != IntegratorKind::RK4);
   }
 };

@@ -122,12 +122,20 @@ void readContactExtension(Tokenizer& in, World& world, const ReaderLimits&) {
   if (!model) in.fail(name, "unknown contact model (known: " + contactModelNames() + ")");
   ContactLaw law;
   law.model = *model;
+  law.mu = world.contact.mu;  // the friction extension may come first
+  law.slipSpeed = world.contact.slipSpeed;
   if (law.model == ContactModel::Smooth) law.layer = in.positive("smooth contact layer");
   if (law.model == ContactModel::Barrier) {
     law.dhat = in.positive("barrier distance dhat");
     law.kappa = in.positive("barrier stiffness kappa");
   }
   world.contact = law;
+}
+
+// `friction MU SLIP`: Coulomb's coefficient (>= 0) and the slip speed eps_v (m/s, > 0).
+void readFrictionExtension(Tokenizer& in, World& world, const ReaderLimits&) {
+  world.contact.mu = in.nonNegative("friction coefficient mu");
+  world.contact.slipSpeed = in.positive("friction slip speed");
 }
 
 struct Extension {
@@ -138,6 +146,7 @@ constexpr Extension kExtensions[] = {
     {"integrator", readIntegratorExtension}, {"cube", readCubeExtension},
     {"sphere", readSphereExtension},         {"cone", readConeExtension},
     {"spiral", readSpiralExtension},         {"contact", readContactExtension},
+    {"friction", readFrictionExtension},
 };
 
 const Extension* extension(std::string_view keyword) {

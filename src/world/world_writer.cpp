@@ -100,6 +100,9 @@ std::string formatWorld(const World& w, NumberFormat format) {
   if (w.contact.model == ContactModel::Barrier) {
     extension(contact, {w.contact.dhat, w.contact.kappa});
   }
+  if (!w.contact.frictionIsDefault()) {
+    extension("friction", {w.contact.mu, w.contact.slipSpeed});
+  }
   return p.take();
 }
 

@@ -102,6 +102,30 @@ def test_contact_model_is_an_attribute_and_a_create_world_keyword(jello_w, tmp_p
         jello.create_world(contact_layer=0.003)
 
 
+def test_friction_is_an_attribute_and_its_work_is_in_the_energy(jello_w, tmp_path):
+    assert (jello_w.friction, jello_w.slip_speed) == (0.0, 0.001)
+    w = jello_w.copy()
+    w.friction = 0.5
+    w.contact = "smooth"  # friction survives a change of model
+    assert w.friction == 0.5
+    with pytest.raises(ValueError):
+        w.friction = -1.0
+    with pytest.raises(ValueError):
+        w.slip_speed = 0.0
+    w.save(str(tmp_path / "friction.w"))
+    assert jello.load_world(str(tmp_path / "friction.w")) == w
+    made = jello.create_world(friction=0.3, slip_speed=0.002)
+    assert (made.friction, made.slip_speed) == (0.3, 0.002)
+    with pytest.raises(ValueError):
+        jello.create_world(slip_speed=0.002)
+    sim = jello.Simulation(w, integrator="implicit", dt=0.01)
+    sim.run(steps=60)  # into the walls
+    e = sim.energy()
+    assert e["friction"] > 0.0  # dissipated
+    assert e["total"] == pytest.approx(
+        e["kinetic"] + e["spring"] + e["contact"] + e["field"] + e["user"] + e["friction"])
+
+
 def test_the_barrier_has_dhat_and_kappa_and_a_simulation_reports_the_least_distance(jello_w):
     w = jello_w.copy()
     w.contact = "barrier"

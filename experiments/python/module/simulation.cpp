@@ -199,8 +199,10 @@ class PySimulation {
     noticeEdits();
     const jello::Energy e = sim_.model().energy(sim_.state());
     const double field = 0.0 - sim_.fieldWork(), user = 0.0 - sim_.userForceWork();  // +0 J
+    const double friction = 0.0 - sim_.frictionWork();
     return py::dict("kinetic"_a = e.kinetic, "spring"_a = e.spring, "contact"_a = e.contact,
-                    "field"_a = field, "user"_a = user, "total"_a = e.total() + field + user);
+                    "field"_a = field, "user"_a = user, "friction"_a = friction,
+                    "total"_a = e.total() + field + user + friction);
   }
 
   py::dict stats() {

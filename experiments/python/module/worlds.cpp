@@ -97,13 +97,16 @@ void saveWorld(const World& w, const std::string& path, bool legacy) {
 namespace {
 
 // The law a model's name gives: smooth keeps a layer already set, else takes the default; the
-// barrier keeps its dhat and kappa, else takes kDefaultBarrierDistance and kCollision.
+// barrier keeps its dhat and kappa, else takes kDefaultBarrierDistance and kCollision; friction
+// is kept.
 jello::ContactLaw contactLaw(const std::string& name, const jello::ContactLaw& was,
                              double kCollision) {
   const std::optional<jello::ContactModel> model = jello::contactModelFromName(name);
   if (!model) valueError("contact must be one of " + jello::contactModelNames());
   jello::ContactLaw law;
   law.model = *model;
+  law.mu = was.mu;
+  law.slipSpeed = was.slipSpeed;
   if (*model == jello::ContactModel::Smooth) {
     law.layer = was.layer > 0.0 ? was.layer : jello::kDefaultContactLayer;
   }
@@ -128,7 +131,7 @@ void setBarrierParameter(jello::ContactLaw& law, double& field, double value, co
 // that the world reads back.
 World createWorld(const py::kwargs& kwargs) {
   jello::SceneSpec spec;
-  std::optional<double> fieldStrength, contactLayer, dhat, kappa;
+  std::optional<double> fieldStrength, contactLayer, dhat, kappa, mu, slipSpeed;
   for (const auto& [key, value] : kwargs) {
     const std::string name = py::cast<std::string>(key);
     const char* n = name.c_str();
@@ -157,6 +160,10 @@ World createWorld(const py::kwargs& kwargs) {
       dhat = positive(real(), n);
     } else if (name == "kappa") {
       kappa = positive(real(), n);
+    } else if (name == "friction") {
+      mu = nonNegative(real(), n);
+    } else if (name == "slip_speed") {
+      slipSpeed = positive(real(), n);
     } else if (name == "plane") {
       if (value.is_none()) {
         spec.plane.reset();
@@ -227,7 +234,7 @@ World createWorld(const py::kwargs& kwargs) {
                  "' (known: integrator, dt, steps_per_frame, k_elastic, d_elastic, k_collision, "
                  "d_collision, mass, plane, field, field_strength, field_resolution, pose, "
                  "stretch, rotate, axis, translate, velocity, spin, sphere, cube, contact, "
-                 "contact_layer, dhat, kappa)");
+                 "contact_layer, dhat, kappa, friction, slip_speed)");
     }
   }
   // The model's parameters once every keyword is read (k_collision may come after contact).
@@ -241,6 +248,11 @@ World createWorld(const py::kwargs& kwargs) {
   }
   if (dhat) setBarrierParameter(spec.contact, spec.contact.dhat, *dhat, "dhat");
   if (kappa) setBarrierParameter(spec.contact, spec.contact.kappa, *kappa, "kappa");
+  spec.contact.mu = mu.value_or(0.0);
+  if (slipSpeed) {
+    if (!(spec.contact.mu > 0.0)) valueError("slip_speed applies with friction only");
+    spec.contact.slipSpeed = *slipSpeed;
+  }
   spec.fieldStrength = fieldStrength.value_or(jello::defaultFieldStrength(spec.field, spec.mass));
   const World world = jello::buildWorld(spec);
   try {
@@ -314,6 +326,14 @@ void bindWorlds(py::module_& m) {
           "kappa", [](const World& w) { return w.contact.kappa; },
           [](World& w, double v) { setBarrierParameter(w.contact, w.contact.kappa, v, "kappa"); },
           "the barrier's stiffness scale, N/m (0 for the other models)")
+      .def_property(
+          "friction", [](const World& w) { return w.contact.mu; },
+          [](World& w, double v) { w.contact.mu = nonNegative(v, "friction"); },
+          "Coulomb friction's coefficient mu on every solid (0: none, the course's)")
+      .def_property(
+          "slip_speed", [](const World& w) { return w.contact.slipSpeed; },
+          [](World& w, double v) { w.contact.slipSpeed = positive(v, "slip_speed"); },
+          "friction's slip speed eps_v, m/s: below it friction is static, a stiff damper")
       .def_property(
           "mass", [](const World& w) { return w.mass; },
           [](World& w, double v) { w.mass = positive(v, "mass"); }, "mass of each point, kg")
