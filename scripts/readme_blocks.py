@@ -15,6 +15,7 @@ BLOCKS = {
     "integrator-list": "README.md",
     "ci-time": "README.md",
     "contact-newton": "README.md",
+    "contact-speed": "README.md",
     "experiments-runtime": "experiments/README.md",
     "stability-summary": "experiments/README.md",
     "work-precision-summary": "experiments/README.md",

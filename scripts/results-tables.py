@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """The documents' results from the committed CSV and JSON alone (no number typed by hand):
-the README's findings and CI time, and the experiments' summaries (experiments/README.md).
+the README's findings, CI time and contact tables (contact-newton from contact_models.json,
+contact-speed from contact_speed.json: scripts/contact-table.py, scripts/contact-speed.py), and
+the experiments' summaries (experiments/README.md).
 
 Rewrites the blocks between <!-- stability-summary:begin/end --> (the stability map's measured
 thresholds against their predictions, per integrator and scene, from
@@ -612,6 +614,16 @@ def ci_time():
             f"the stages over half a minute: {stages} minutes.")
 
 
+def _contact_speed():
+    """scripts/contact-speed.py as a module (its name has a hyphen)."""
+    import importlib.util
+    spec = importlib.util.spec_from_file_location(
+        "contact_speed", os.path.join(os.path.dirname(os.path.abspath(__file__)), "contact-speed.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def contact_cell(r):
     """One run of the contact table: unconverged (retried), Newton/step, least distance."""
     if "refused" in r:
@@ -671,6 +683,7 @@ BLOCKS = {"findings": findings,
           "integrator-list": integrator_list,
           "ci-time": ci_time,
           "contact-newton": contact_newton,
+          "contact-speed": lambda: _contact_speed().table(),
           "stability-summary": stability_summary,
           "scaling-summary": scaling_summary,
           "work-precision-summary": work_precision_summary,

@@ -191,6 +191,14 @@ bool Model::hasFriction() const {
   return friction_;
 }
 
+void Model::frictionForces(const double* x, const double* v, Eigen::VectorXd& f) const {
+  f.setZero(3 * n_);
+  if (!friction_) return;
+  for (const auto& o : obstacles_) {
+    o->addFrictionForces(frictionAt_ ? frictionAt_ : x, v, f.data(), n_, 0, n_);
+  }
+}
+
 double Model::frictionPotential(const double* x, const double* v) const {
   if (!friction_) return 0.0;
   double potential = 0.0;

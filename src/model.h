@@ -135,6 +135,9 @@ class Model {
    private:
     const Model& model_;
   };
+  // Friction's forces alone at (x, v) (N, f resized to 3n; zero without friction): what the
+  // viewer draws.
+  void frictionForces(const double* x, const double* v, Eigen::VectorXd& f) const;
   // Friction's dissipation potential (W) at velocities v, lambda and n from positions x or the
   // lag (Obstacle::frictionPotential): with the lag, the force is minus its gradient in v.
   double frictionPotential(const double* x, const double* v) const;

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <random>
 
 #include "solvers/cvode/cvode_integrator.h"
 #include "solvers/methods/explicit_integrators.h"
@@ -149,10 +150,9 @@ TEST(Cvode, TranslatingTheSceneTranslatesTheAnswer) {
   EXPECT_EQ(statsOf(ca).at("cvode_steps"), statsOf(cb).at("cvode_steps"));
 }
 
-TEST(Cvode, ContactRootsFireAtJellosContactOnset) {
-  // jello.w first touches a wall or the plane a few hundredths of a second in: the first
-  // output step that reports a root is the one in which some point first passes a surface.
-  const World w = test::loadWorld("jello.w");
+// The first output step (5 ms) that reports a root is the one in which some point first passes
+// a surface.
+void expectRootsAtTheContactOnset(const World& w) {
   const Model model(w);
   CvodeOptions options;
   options.rtol = 1e-4;
@@ -166,8 +166,60 @@ TEST(Cvode, ContactRootsFireAtJellosContactOnset) {
     if (firstRoot < 0 && statsOf(cvode).at("contact_roots") > 0) firstRoot = i;
     if (firstContact < 0 && model.contactBegins(before.x.data(), s.x.data())) firstContact = i;
   }
-  ASSERT_GE(firstContact, 0) << "jello.w reaches a surface within 0.1 s";
+  ASSERT_GE(firstContact, 0) << "the cube reaches a surface within 0.1 s";
   EXPECT_EQ(firstRoot, firstContact);
+}
+
+TEST(Cvode, ContactRootsFireAtJellosContactOnset) {
+  // jello.w first touches a wall or the plane a few hundredths of a second in.
+  expectRootsAtTheContactOnset(test::loadWorld("jello.w"));
+}
+
+TEST(Cvode, ContactRootsFireWhereTheCubeMeetsTheCone) {
+  // A cube thrown down at 5 m/s onto a cone's apex 0.2 m below its bottom face: the cone's
+  // signed distance is its root function.
+  SceneSpec spec;
+  spec.pose = PosePreset::Rest;
+  spec.velocity = {0.0, 0.0, -5.0};
+  spec.plane.reset();
+  spec.fieldResolution = 0;
+  spec.cone = Cone{{0.5, 0.5, -0.2}, {0.0, 0.0, -1.0}, 1.5, 1.0};
+  expectRootsAtTheContactOnset(buildWorld(spec));
+}
+
+TEST(Cvode, ContactRootsFireWhereTheCubeMeetsTheSpiral) {
+  // The showcase's spiral ramp, the cube thrown down onto its first turn; its root function is
+  // < 0 exactly inside (checked at random points first).
+  const Spiral spiral{0.0, 0.0, 0.6, 0.75, 1.95, 1.3, 1.5, 0.25};
+  ModelSpec alone;
+  alone.numPoints = 1;
+  alone.mass = 1.0;
+  alone.walls = false;
+  alone.spiral = spiral;
+  const Model probe(alone);
+  const Obstacle& o = *probe.obstacles().front();
+  ASSERT_EQ(o.rootsPerPoint(), 1);
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  int inside = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3 x{u(rng), u(rng), u(rng)};
+    double g = 0.0;
+    const double xs[3] = {x.x, x.y, x.z};
+    o.roots(xs, 1, &g);
+    const bool in = o.depth(x) > 0.0;
+    inside += in;
+    EXPECT_EQ(g < 0.0, in) << x.x << " " << x.y << " " << x.z << " g " << g;
+  }
+  EXPECT_GT(inside, 100);
+  SceneSpec spec;
+  spec.pose = PosePreset::Translated;
+  spec.translate = {0.55, 0.55, 0.55};
+  spec.velocity = {0.0, 0.0, -5.0};
+  spec.plane.reset();
+  spec.fieldResolution = 0;
+  spec.spiral = spiral;
+  expectRootsAtTheContactOnset(buildWorld(spec));
 }
 
 TEST(Cvode, RespectsTheMaximumOrder) {

@@ -305,5 +305,43 @@ TEST(ViewerSession, TheHeadsUpEnergyIncludesTheFieldAndRk4ConservesIt) {
   EXPECT_GT(scale, 5.0);  // J: the test is not of a cube at rest
 }
 
+// Friction's arrows (drawn with the field's, key f): one per point friction acts on, from the
+// point along its friction force, tangential to the floor and against the slide; none without
+// friction.
+TEST(FrictionArrows, PointAgainstTheSlideAlongTheFloorFromEachTouchingPoint) {
+  SceneSpec spec;
+  spec.integrator = IntegratorKind::Implicit;
+  spec.dt = 0.002;
+  spec.cubeResolution = 4;
+  spec.pose = PosePreset::Rest;
+  spec.velocity = {1.0, 0.5, 0.0};
+  spec.plane.reset();
+  spec.kCollision = 1e4;
+  spec.field = FieldPreset::Gravity;
+  spec.fieldResolution = 2;
+  spec.fieldStrength = 9.81 * spec.mass;
+  spec.contact.mu = 0.5;
+  World w = buildWorld(spec);
+  for (Vec3& p : w.positions) p = p + Vec3{-0.5, -0.5, -2.0 + 1e-4};  // on the floor
+  Simulation sim(w);
+  for (int i = 0; i < 20; ++i) ASSERT_TRUE(sim.step().ok);
+  const std::vector<Arrow> arrows = frictionArrows(sim, 0.25);
+  ASSERT_EQ(arrows.size(), 16u);  // the bottom face's 4 x 4 points
+  double longest = 0.0;
+  for (const Arrow& a : arrows) {
+    const Vec3 d = a.head - a.tail;
+    longest = std::max(longest, norm(d));
+    EXPECT_NEAR(a.tail.z, -2.0, 1e-2);
+    EXPECT_NEAR(d.z, 0.0, 1e-12);  // tangential to the floor
+    EXPECT_LT(dot(d, Vec3{1.0, 0.5, 0.0}), -0.99 * norm(d) * norm(Vec3{1.0, 0.5, 0.0}));
+    EXPECT_GT(a.magnitude, 0.0);
+  }
+  EXPECT_NEAR(longest, 0.25, 1e-12);
+  w.contact.mu = 0.0;
+  Simulation without(w);
+  for (int i = 0; i < 20; ++i) ASSERT_TRUE(without.step().ok);
+  EXPECT_TRUE(frictionArrows(without).empty());
+}
+
 }  // namespace
 }  // namespace jello::viewer

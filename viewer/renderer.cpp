@@ -251,13 +251,15 @@ void drawPlane(const Plane& plane) {
   glEnd();
 }
 
-// Arrows with heads (two barbs in the plane facing the camera), coloured by strength.
-void drawArrows(const std::vector<Arrow>& arrows, const Camera& camera) {
+// Arrows with heads (two barbs in the plane facing the camera), coloured by strength or all in
+// `colour` when given.
+void drawArrows(const std::vector<Arrow>& arrows, const Camera& camera,
+                const std::array<float, 3>* colour = nullptr) {
   const Vec3 toEye = camera.forward() * -1.0;
   glLineWidth(1.5f);
   glBegin(GL_LINES);
   for (const Arrow& a : arrows) {
-    const std::array<float, 3> c = strengthColour(a.strength);
+    const std::array<float, 3> c = colour ? *colour : strengthColour(a.strength);
     glColor3f(c[0], c[1], c[2]);
     const Vec3 d = a.head - a.tail;
     const double length = norm(d);
@@ -383,6 +385,10 @@ void drawFrame(const ViewerState& view, const Viewport& viewport, const Scene& s
   if (scene.world->cone) drawCone(*scene.world->cone);
   if (scene.world->spiral) drawSpiral(*scene.world->spiral);
   if (view.showField && scene.arrows) drawArrows(*scene.arrows, view.camera);
+  if (view.showField && scene.friction) {
+    const std::array<float, 3> frictionColour{1.0f, 0.55f, 0.1f};  // orange, off the legend
+    drawArrows(*scene.friction, view.camera, &frictionColour);
+  }
   if (scene.pull) drawPull(view, scene);
   if (scene.push) drawPush(view, scene);
   if (scene.world->plane) drawPlane(*scene.world->plane);  // blended: last

@@ -26,6 +26,7 @@ struct Scene {
   const SurfaceMesh* mesh = nullptr;
   const std::vector<Spring>* springs = nullptr;  // surface springs
   const std::vector<Arrow>* arrows = nullptr;    // field arrows
+  const std::vector<Arrow>* friction = nullptr;  // friction's forces, shown with the field's
   std::optional<std::pair<Vec3, Vec3>> pull;     // picked point and its target, while pulling
   double pullRadius = 0.0;                       // m, the pull's fall-off radius (rest length)
   std::optional<std::pair<Vec3, Vec3>> push;     // from the cube's centre along the push

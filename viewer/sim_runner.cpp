@@ -34,6 +34,27 @@ EnergyReport energyReport(const Simulation& sim) {
   return r;
 }
 
+std::vector<Arrow> frictionArrows(const Simulation& sim, double longest) {
+  std::vector<Arrow> arrows;
+  if (!sim.model().hasFriction()) return arrows;
+  const State& s = sim.state();
+  Eigen::VectorXd f;
+  sim.model().frictionForces(s.x.data(), s.v.data(), f);
+  const int n = s.numPoints();
+  double strongest = 0.0;
+  for (int p = 0; p < n; ++p) strongest = std::max(strongest, norm(State::at(f, p)));
+  if (!(strongest > 0.0) || !std::isfinite(strongest)) return arrows;
+  for (int p = 0; p < n; ++p) {
+    const Vec3 force = State::at(f, p);
+    const double magnitude = norm(force);
+    if (magnitude == 0.0) continue;
+    const Vec3 tail = s.position(p);
+    arrows.push_back(
+        {tail, tail + force * (longest / strongest), magnitude / strongest, magnitude});
+  }
+  return arrows;
+}
+
 SimRunner::SimRunner(SceneSource source, World world, Options options)
     : session_(std::move(source), std::move(world)), options_(std::move(options)) {
   if (!options_.clock) options_.clock = steadySeconds;
@@ -183,6 +204,7 @@ void SimRunner::publish(std::unique_lock<std::mutex>& lock) {
   f.energy = energyReport(sim);
   f.angularMomentum = sim.model().angularMomentum(sim.state());
   f.solver = sim.integrator().statistics();
+  f.friction = frictionArrows(sim);
   f.solverOptions = sim.solverOptions();
   if (sim.divergence()) f.divergence = sim.divergence()->describe();
   f.pull = session_.pulling();

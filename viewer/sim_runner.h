@@ -37,6 +37,9 @@ struct EnergyReport {
   double total() const { return kinetic + spring + contact + field + user + friction; }
 };
 EnergyReport energyReport(const Simulation& sim);
+// Friction's force on each point that has one, as arrows from the point along the force (the
+// strongest `longest` metres long); none without friction or contact.
+std::vector<Arrow> frictionArrows(const Simulation& sim, double longest = 0.25);
 
 // One published picture of the simulation.
 struct Frame {
@@ -49,6 +52,7 @@ struct Frame {
   EnergyReport energy;
   Vec3 angularMomentum;
   std::vector<Statistic> solver;  // the integrator's counters
+  std::vector<Arrow> friction;    // friction's forces (frictionArrows), drawn with the field's
   SolverOptions solverOptions;    // the integrator's settings
   std::optional<std::string> divergence;
   std::optional<std::pair<int, Vec3>> pull;  // picked point and target while pulling

@@ -77,6 +77,7 @@ Scene Viewer::scene(std::size_t pane) const {
   s.mesh = &g.mesh;
   s.springs = &g.springs;
   s.arrows = &g.arrows;
+  s.friction = &f.friction;
   if (view_.texture) s.texture = &texture_;
   if (f.pull) {
     s.pull = std::pair(f.state.position(f.pull->first), f.pull->second);

@@ -12,7 +12,10 @@ void Viewer::key(unsigned char key) {
   if (panel_.key(key, lastX_, lastY_)) return glutPostRedisplay();  // typing into the panel
   const KeyResult result = handleKey(view_, key);
   if (key == 'f' && view_.showField && primary().geometry->arrows.empty()) {
-    notify("this world has no force field (or it is zero everywhere): no arrows to draw", false);
+    notify(primary().geometry->world.contact.mu > 0.0
+               ? "this world has no force field: only friction's arrows (orange) are drawn"
+               : "this world has no force field (or it is zero everywhere): no arrows to draw",
+           false);
   }
   switch (result.command) {
     case Command::Quit:

@@ -17,6 +17,12 @@
 //                               kept factor M/h^2 + L at N^3 (h = 0.01): our own substitutions
 //                               over the copied factor or over its supernodes in single
 //                               precision, or CHOLMOD's cholmod_solve2 (counter nnz_L)
+//   BM_ContactRun/<integrator>/<model>/N  jello.w at N^3 under a contact model for 30 steps at
+//                               dt = 0.01 (its cube meets the walls and the plane), wall time
+//                               per step over steps 2-30 (manual time; the first, with the
+//                               set-up, left out); counters: Newton iterations per step,
+//                               unconverged steps, factorizations, factor updates, contact-set
+//                               changes, barrier cuts (scripts/contact-speed.py)
 //   BM_Crossover/<method>/E     1 simulated second of the spinning stretched cube at k = 10^E
 //                               with damping 0.25 (8^3): projective at dt = 1/60, implicit and
 //                               bdf2 at dt = 0.01 (also in fastNewton's configuration), RK4 at
@@ -227,6 +233,37 @@ void BM_ImplicitIntegratorStep(benchmark::State& st, IntegratorKind kind,
     if (s.name == "newton_unconverged_steps") st.counters["unconverged"] = s.value;
   }
 }
+// BM_ContactRun (above): a fresh run per iteration, so every iteration meets the same contacts.
+void BM_ContactRun(benchmark::State& st, IntegratorKind kind, ContactModel model) {
+  constexpr int kSteps = 30;
+  World w = jelloAt(static_cast<int>(st.range(0)));
+  w.contact.model = model;
+  if (model == ContactModel::Smooth) w.contact.layer = kDefaultContactLayer;
+  if (model == ContactModel::Barrier) {
+    w.contact.dhat = kDefaultBarrierDistance;
+    w.contact.kappa = w.kCollision;
+  }
+  std::vector<Statistic> stats;
+  for (auto _ : st) {
+    Simulation sim(w, kind, 0.01);
+    if (!sim.step().ok) st.SkipWithError("first step failed");
+    const auto start = std::chrono::steady_clock::now();
+    for (int i = 1; i < kSteps; ++i) {
+      if (!sim.step().ok) st.SkipWithError("step failed");
+    }
+    const std::chrono::duration<double> took = std::chrono::steady_clock::now() - start;
+    st.SetIterationTime(took.count() / (kSteps - 1));
+    stats = sim.integrator().statistics();
+  }
+  for (const Statistic& s : stats) {
+    for (const char* name :
+         {"newton_iterations_per_step", "newton_unconverged_steps", "factorizations",
+          "factor_updates", "contact_set_changes", "barrier_cuts"}) {
+      if (s.name == name) st.counters[name] = s.value;
+    }
+  }
+}
+
 }  // namespace
 
 // Every implicit integrator of the table (src/world/integrator_table.h) at N = 8 and 16 on both
@@ -255,6 +292,21 @@ void registerImplicitStepBenchmarks() {
     }
   }
   add("projective", IntegratorKind::Projective, {}, {32});
+  for (IntegratorKind kind : {IntegratorKind::Projective, IntegratorKind::Implicit}) {
+    for (ContactModel model : allContactModels()) {
+      benchmark::RegisterBenchmark(
+          ("BM_ContactRun/" + std::string(integratorName(kind)) + "/" +
+           std::string(contactModelName(model)))
+              .c_str(),
+          [kind, model](benchmark::State& st) { BM_ContactRun(st, kind, model); })
+          ->Arg(8)
+          ->Arg(16)
+          ->ArgName("N")
+          ->UseManualTime()
+          ->Iterations(3)
+          ->Unit(benchmark::kMillisecond);
+    }
+  }
 }
 
 namespace {

@@ -180,6 +180,32 @@ std::optional<Penetration> spiralPenetration(const Spiral& s, const Vec3& x) {
   return p;
 }
 
+namespace {
+
+// CVODE's root function for the spiral: minus the largest, over the turns Theta = theta + 2 pi k,
+// of the smallest of the six face depths of spiralPenetration (each negative past its face), so
+// > 0 outside, < 0 inside, 0 on the surface, and continuous but on the ray theta = 0 outside
+// the slab (where it does not change sign).
+double spiralRoot(const Spiral& s, const Vec3& x) {
+  const double px = x.x - s.cx, py = x.y - s.cy;
+  const double r = std::hypot(px, py);
+  const double c = s.pitch / (2.0 * std::numbers::pi);
+  double theta = std::atan2(py, px);
+  if (theta < 0.0) theta += 2.0 * std::numbers::pi;
+  const double span = 2.0 * std::numbers::pi * s.turns;
+  const double outer = s.rOuter - r;
+  const double inner = s.rInner > 0.0 ? r - s.rInner : std::numeric_limits<double>::infinity();
+  double best = -std::numeric_limits<double>::infinity();
+  for (double big = theta; big <= span + 2.0 * std::numbers::pi; big += 2.0 * std::numbers::pi) {
+    const double top = s.zTop - c * big - x.z;
+    best =
+        std::max(best, std::min({top, s.thickness - top, outer, inner, r * big, r * (span - big)}));
+  }
+  return -best;
+}
+
+}  // namespace
+
 ObstacleContact::ObstacleContact(const Cone& cone, ContactConstants k) : Obstacle(k), cone_(cone) {}
 ObstacleContact::ObstacleContact(const Spiral& spiral, ContactConstants k)
     : Obstacle(k), spiral_(spiral) {}
@@ -265,6 +291,13 @@ void ObstacleContact::addContactWeights(const double* x, int n, std::ptrdiff_t l
                                         const std::array<double*, 3>& w) const {
   addToAllCoordinates(lo, hi, weight, w,
                       [&](std::ptrdiff_t p) { return inside(pointAt(x, n, int(p))); });
+}
+
+void ObstacleContact::roots(const double* x, int n, double* g) const {
+  for (int p = 0; p < n; ++p) {
+    const Vec3 xp = pointAt(x, n, p);
+    g[p] = cone_ ? signedDistance(xp) : spiralRoot(*spiral_, xp);
+  }
 }
 
 }  // namespace jello

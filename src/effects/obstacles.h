@@ -44,6 +44,10 @@ class ObstacleContact final : public Obstacle {
   int penetrations(const Vec3& x, double reach, Penetration* out) const override;
   double signedDistance(const Vec3& x) const override;
   bool hasExteriorDistance() const override { return cone_.has_value(); }
+  // CVODE's roots: the cone's signed distance (continuous, 0 on its surface); the spiral's
+  // face depths, max over its turns of their min, negated (obstacles.cpp, spiralRoot).
+  int rootsPerPoint() const override { return 1; }
+  void roots(const double* x, int n, double* g) const override;
   double depth(const Vec3& x) const override;
   bool contactBegins(const double* x0, const double* x1, int n) const override;
   int contactSprings(const Vec3& x) const override;
