@@ -66,7 +66,7 @@ unsigned Model::addPointForces(const double* x, const double* v, double* f, int 
   unsigned evaluated = 0;
   for (std::size_t i = 0; i < obstacles_.size(); ++i) {
     if (obstacles_[i]->addForces(x, v, f, n, lo, hi)) evaluated |= 1u << i;
-    if (friction_) obstacles_[i]->addFrictionForces(frictionAt_ ? frictionAt_ : x, v, f, n, lo, hi);
+    if (friction_) obstacles_[i]->addFrictionForces(frictionPositions(x), v, f, n, lo, hi);
   }
   if (field_) field_->accumulate(x, f, n, lo, hi);
   if (userForce_) {
@@ -163,7 +163,7 @@ void Model::addJacobian(const double* x, JacobianBlocks& out) const {
   for (const auto& o : obstacles_) {
     o->addJacobian(x, n_, out);
     if (friction_ && out.velocities) {
-      o->addFrictionJacobian(frictionAt_ ? frictionAt_ : x, out.velocities, n_, out);
+      o->addFrictionJacobian(frictionPositions(x), out.velocities, n_, out);
     }
   }
   if (field_) field_->addJacobian(x, n_, out);
@@ -195,15 +195,14 @@ void Model::frictionForces(const double* x, const double* v, Eigen::VectorXd& f)
   f.setZero(3 * n_);
   if (!friction_) return;
   for (const auto& o : obstacles_) {
-    o->addFrictionForces(frictionAt_ ? frictionAt_ : x, v, f.data(), n_, 0, n_);
+    o->addFrictionForces(frictionPositions(x), v, f.data(), n_, 0, n_);
   }
 }
 
 double Model::frictionPotential(const double* x, const double* v) const {
   if (!friction_) return 0.0;
   double potential = 0.0;
-  for (const auto& o : obstacles_)
-    potential += o->frictionPotential(frictionAt_ ? frictionAt_ : x, v, n_);
+  for (const auto& o : obstacles_) potential += o->frictionPotential(frictionPositions(x), v, n_);
   return potential;
 }
 

@@ -206,6 +206,8 @@ class Model {
   std::optional<Eigen::VectorXd> userForce_;
   bool friction_ = false;
   mutable const double* frictionAt_ = nullptr;  // FrictionLag's positions, or none
+  // Where friction takes its normal forces from at positions x: the lag's, else x.
+  const double* frictionPositions(const double* x) const { return frictionAt_ ? frictionAt_ : x; }
   struct Counters {
     std::atomic<long> springs{0}, field{0}, user{0};
     std::array<std::atomic<long>, kObstacleKinds> obstacles{}, skipped{};

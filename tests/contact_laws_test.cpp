@@ -27,14 +27,7 @@ constexpr double kLayer = 0.05;
 const ContactConstants kSmooth{1000.0, 0.3, ContactModel::Smooth, kLayer};
 const ContactConstants kPenalty{1000.0, 0.3};
 
-ModelSpec onePoint(const ContactConstants& k) {
-  ModelSpec spec;
-  spec.numPoints = 1;
-  spec.mass = 0.01;
-  spec.walls = false;
-  spec.contact = k;
-  return spec;
-}
+using test::onePoint;
 
 // One model per solid, each alone (the walls too).
 std::vector<ModelSpec> everySolid(const ContactConstants& k) {
@@ -48,12 +41,7 @@ std::vector<ModelSpec> everySolid(const ContactConstants& k) {
 }
 
 State at(const Vec3& x, const Vec3& v = {0, 0, 0}) {
-  State s;
-  s.x.resize(3);
-  s.v.resize(3);
-  State::set(s.x, 0, x);
-  State::set(s.v, 0, v);
-  return s;
+  return test::pointAt(x, v);
 }
 
 // Random points of [-2.1, 2.1]^3 touching the model's one solid at depth in [1e-3, deepest],

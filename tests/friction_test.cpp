@@ -42,15 +42,11 @@ TEST(SmoothedFriction, IsC1AtTheSlipSpeedAndItsDerivativesAreEachOthers) {
   EXPECT_NEAR(smoothedFriction(0.0, e).g, 2.0 / e, 1e-12);
 }
 
+// test::onePoint with friction mu = kMu, eps = kSlip.
 ModelSpec onePoint(ContactConstants k) {
   k.mu = kMu;
   k.slipSpeed = kSlip;
-  ModelSpec spec;
-  spec.numPoints = 1;
-  spec.mass = 0.01;
-  spec.walls = false;
-  spec.contact = k;
-  return spec;
+  return test::onePoint(k);
 }
 
 // A model per solid and law: the walls, the plane, the sphere and the cone (the spiral has no
@@ -72,12 +68,7 @@ std::vector<ModelSpec> everySolidAndLaw() {
 }
 
 State at(const Vec3& x, const Vec3& v) {
-  State s;
-  s.x.resize(3);
-  s.v.resize(3);
-  State::set(s.x, 0, x);
-  State::set(s.v, 0, v);
-  return s;
+  return test::pointAt(x, v);
 }
 
 // Points where the model's one solid pushes with a normal force (in it, or within the

@@ -105,12 +105,7 @@ ModelSpec onePoint(bool walls) {
 }
 
 State at(const Vec3& x, const Vec3& v = {0.3, -0.2, 0.1}) {
-  State s;
-  s.x.resize(3);
-  s.v.resize(3);
-  State::set(s.x, 0, x);
-  State::set(s.v, 0, v);
-  return s;
+  return test::pointAt(x, v);
 }
 
 TEST(ContactJacobian, MatchesFiniteDifferencesAtEachWall) {

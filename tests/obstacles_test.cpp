@@ -34,12 +34,7 @@ ModelSpec onePoint(const std::optional<Cone>& cone, const std::optional<Spiral>&
 }
 
 State at(const Vec3& x, const Vec3& v = {0, 0, 0}) {
-  State s;
-  s.x.resize(3);
-  s.v.resize(3);
-  State::set(s.x, 0, x);
-  State::set(s.v, 0, v);
-  return s;
+  return test::pointAt(x, v);
 }
 
 // Random points of the box [-2, 2]^3 inside the obstacle, away from where the nearest face

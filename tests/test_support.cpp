@@ -51,6 +51,24 @@ TempDir::~TempDir() {
   std::filesystem::remove_all(path_, ec);
 }
 
+ModelSpec onePoint(const ContactConstants& k) {
+  ModelSpec spec;
+  spec.numPoints = 1;
+  spec.mass = 0.01;
+  spec.walls = false;
+  spec.contact = k;
+  return spec;
+}
+
+State pointAt(const Vec3& x, const Vec3& v) {
+  State s;
+  s.x.resize(3);
+  s.v.resize(3);
+  State::set(s.x, 0, x);
+  State::set(s.v, 0, v);
+  return s;
+}
+
 ModelSpec singleSpring(double stiffness, double damping, double rest, double mass) {
   ModelSpec spec;
   spec.numPoints = 2;

@@ -38,6 +38,11 @@ class TempDir {
 // Two points joined by one spring along x, point 0 at the origin, no walls, no field.
 ModelSpec singleSpring(double stiffness, double damping, double rest, double mass);
 
+// One point of 10 g, no spring, no walls: the contact tests' model, with contact constants k.
+ModelSpec onePoint(const ContactConstants& k);
+// The state of one point at x moving at v.
+State pointAt(const Vec3& x, const Vec3& v);
+
 // Two points of mass m joined by a spring of rest length 0: the force k (x_j - x_i) is exactly
 // linear, so the relative motion is an undamped isotropic oscillator with w = sqrt(2k/m). The
 // start state keeps the centre of mass at rest at the origin, so energy() is that of the

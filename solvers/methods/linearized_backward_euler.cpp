@@ -40,9 +40,9 @@ void LinearizedBackwardEuler::keepOutside(const Model& model, const State& s, do
 
 StepResult LinearizedBackwardEuler::step(const Model& model, State& s, double h) {
   prepare(model);
-  // Friction's normal forces at the step's start, as the Newton methods take them.
-  const Eigen::VectorXd lagged = model.hasFriction() ? s.x : Eigen::VectorXd();
-  const Model::FrictionLag lag(model, model.hasFriction() ? lagged.data() : nullptr);
+  // Friction's normal forces at the step's start, as the Newton methods take them (s.x is
+  // written only at the end, after the last evaluation).
+  const Model::FrictionLag lag(model, s.x.data());
   model.forces(s.x, s.v, f_);
   // First iteration, linearized at (x0, v0): rhs = h (f0 + h K v0).
   system_.assemble(s.x.data(), s.v.data());

@@ -150,9 +150,9 @@ StepResult ProjectiveIntegrator::factorChanged(double h) {
 // Long: one step's local/global loop, fused with the force evaluation for speed.
 StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
   bind(model);
-  // Friction's normal forces at the step's start, as the Newton methods take them.
-  const Eigen::VectorXd lagged = model.hasFriction() ? s.x : Eigen::VectorXd();
-  const Model::FrictionLag lag(model, model.hasFriction() ? lagged.data() : nullptr);
+  // Friction's normal forces at the step's start, as the Newton methods take them (s.x is
+  // written only at the end, after the last evaluation).
+  const Model::FrictionLag lag(model, s.x.data());
   const std::ptrdiff_t n = n_, size = 3 * n;
   const double inertia = mass_ / (h * h), inverseH = 1.0 / h;
   y_.resize(size);
