@@ -1,13 +1,15 @@
 #!/usr/bin/env python3
 """What each contact model costs a step: projective and implicit on jello.w at 8^3 and 16^3.
 
-    scripts/contact-speed.py [--run]
+    scripts/contact-speed.py [--run [--only INTEGRATOR]]
 
 --run runs the benchmarks BM_ContactRun/<integrator>/<model>/N (experiments/bench/
 benchmarks_implicit.cpp: 30 steps at dt = 0.01 from jello.w's start, the cube meeting the walls
 and the plane, wall time per step after the first) on one core of the native build with
 single-threaded BLAS and CHOLMOD, and writes Google Benchmark's JSON to
-experiments/results/contact_speed.json. Without it, prints the README's table (block
+experiments/results/contact_speed.json; with --only, those of one integrator, replacing its
+entries in that file and keeping the others' (implicit at 16^3 takes ten minutes). Without it,
+prints the README's table (block
 contact-speed, which scripts/results-tables.py writes from that file alone).
 """
 import argparse
@@ -21,12 +23,22 @@ JSON = os.path.join(ROOT, "experiments", "results", "contact_speed.json")
 BINARY = os.path.join(ROOT, "build", "native", "bin", "benchmarks")
 
 
-def run():
+def run(only=None):
     env = dict(os.environ, OMP_THREAD_LIMIT="1", OPENBLAS_NUM_THREADS="1")
     tmp = JSON + ".tmp"
-    subprocess.run(["taskset", "-c", "0", BINARY, "--benchmark_filter=BM_ContactRun",
+    name = "BM_ContactRun/" + (only + "/" if only else "")
+    subprocess.run(["taskset", "-c", "0", BINARY, f"--benchmark_filter={name}",
                     f"--benchmark_out={tmp}", "--benchmark_out_format=json"],
                    check=True, env=env)
+    if only and os.path.exists(JSON):
+        with open(tmp) as f:
+            fresh = json.load(f)
+        with open(JSON) as f:
+            kept = json.load(f)["benchmarks"]
+        fresh["benchmarks"] = ([b for b in kept if not b["name"].startswith(name)] +
+                               fresh["benchmarks"])
+        with open(tmp, "w") as f:
+            json.dump(fresh, f, indent=2)
     os.replace(tmp, JSON)
 
 
@@ -78,12 +90,14 @@ def table(path=JSON):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--run", action="store_true", help="measure again (about 3 minutes)")
+    parser.add_argument("--run", action="store_true", help="measure again (about 15 minutes)")
+    parser.add_argument("--only", choices=["projective", "implicit"],
+                        help="with --run: measure this integrator alone, keep the other's")
     args = parser.parse_args()
     if args.run:
         if not os.path.exists(BINARY):
             sys.exit(f"contact-speed: no {BINARY}: build the native preset first")
-        run()
+        run(args.only)
     print(table())
 
 

@@ -1,5 +1,5 @@
 // Speed of the core (Google Benchmark; run on one core, e.g.
-// `taskset -c 0 build/release/bin/benchmarks`). Figures are reported in the README with the
+// `taskset -c 0 build/native/bin/benchmarks`). Figures are reported in the README with the
 // machine.
 //   BM_SpringForces/N    one evaluation of every spring; items/s = spring evaluations/s
 //   BM_Step/<integrator>/N  one full step on jello.w resampled to N^3; items/s = steps/s

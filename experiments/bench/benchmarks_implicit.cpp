@@ -256,9 +256,9 @@ void BM_ContactRun(benchmark::State& st, IntegratorKind kind, ContactModel model
     stats = sim.integrator().statistics();
   }
   for (const Statistic& s : stats) {
-    for (const char* name :
-         {"newton_iterations_per_step", "newton_unconverged_steps", "factorizations",
-          "factor_updates", "contact_set_changes", "barrier_cuts"}) {
+    for (const char* name : {"newton_iterations_per_step", "newton_unconverged_steps",
+                             "factorizations", "factor_updates", "contact_set_changes",
+                             "barrier_cuts", "factor_time_s", "solve_time_s"}) {
       if (s.name == name) st.counters[name] = s.value;
     }
   }

@@ -29,6 +29,9 @@ constexpr int kUpdateLimit = 64;
 // Measured on 1 s of jello.w at 16^3: 2.45 s with 128 (41 factorizations), 2.65 s with 256 (39),
 // 2.75 s without a limit; 4.6 s when updates made CHOLMOD solve a double simplicial factor.
 constexpr int kCorrectionLimit = 128;
+// Stale contact weights (factored, no longer wanted: the point left) stay in the factors until
+// they outnumber the wanted ones and this many.
+constexpr long kStaleFloor = 16;
 
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -58,30 +61,71 @@ void ProjectiveIntegrator::bind(const Model& model) {
   factors_ = std::make_unique<Factors>();  // a new pattern: analyzed afresh
   for (int c = 0; c < 3; ++c) {
     weights_[c].setZero(n_);
+    wanted_[c].setZero(n_);
     factoredWeights_[c].setZero(n_);
   }
   factored_ = false;
 }
 
-bool ProjectiveIntegrator::contactWeights(const Model& model, const double* x, std::ptrdiff_t lo,
-                                          std::ptrdiff_t hi) {
-  // Each obstacle's stiffness per contact spring, on the coordinates it reaches.
-  const std::array<double*, 3> w{weights_[0].data(), weights_[1].data(), weights_[2].data()};
+void ProjectiveIntegrator::weightsAt(const Model& model, const double* x, std::ptrdiff_t lo,
+                                     std::ptrdiff_t hi, const std::array<double*, 3>& w) const {
   for (int c = 0; c < 3; ++c) std::fill(w[c] + lo, w[c] + hi, 0.0);
   for (const auto& obstacle : model.obstacles()) {
     obstacle->addContactWeights(x, n_, lo, hi, obstacle->constants().stiffness, w);
   }
-  // The largest difference from the factor's weights: a max, not a flag, so that the loops
-  // vectorize.
-  double differs = 0.0;
+}
+
+long ProjectiveIntegrator::contactWeights(const Model& model, const double* x, std::ptrdiff_t lo,
+                                          std::ptrdiff_t hi) {
+  // Each obstacle's stiffness per contact spring, on the coordinates it reaches.
+  const std::array<double*, 3> w{wanted_[0].data(), wanted_[1].data(), wanted_[2].data()};
+  weightsAt(model, x, lo, hi, w);
+  // The weights above the factor's (covering) or different from them (exact).
+  long count = 0;
+  const bool exact = !options_.coverContacts;
   for (int c = 0; c < 3; ++c) {
     const double* wc = w[c];
     const double* factored = factoredWeights_[factorOf_[c]].data();
-#pragma omp simd reduction(max : differs)
-    for (std::ptrdiff_t p = lo; p < hi; ++p)
-      differs = std::max(differs, std::abs(wc[p] - factored[p]));
+#pragma omp simd reduction(+ : count)
+    for (std::ptrdiff_t p = lo; p < hi; ++p) {
+      count += long(wc[p] > factored[p]) + long(exact && wc[p] < factored[p]);
+    }
   }
-  return differs > 0.0;
+  return count;
+}
+
+bool ProjectiveIntegrator::planWeights(const Model& model, const double* x0, const double* v0,
+                                       double h) {
+  // The weights wanted at x0, at the inertial prediction y = x0 + h v0 and a step beyond it: a
+  // point about to touch is covered before it does.
+  const std::ptrdiff_t size = 3 * std::ptrdiff_t(n_);
+  ahead_.resize(size);
+  const std::array<double*, 3> w{wanted_[0].data(), wanted_[1].data(), wanted_[2].data()};
+  for (int c = 0; c < 3; ++c) weights_[c].setZero(n_);
+  for (double steps : {0.0, 1.0, 2.0}) {
+    for (std::ptrdiff_t i = 0; i < size; ++i) ahead_[i] = x0[i] + steps * h * v0[i];
+    weightsAt(model, ahead_.data(), 0, n_, w);
+    for (int c = 0; c < 3; ++c) weights_[c] = weights_[c].cwiseMax(wanted_[c]);
+  }
+  // One set of weights for the three coordinates (their largest): one factor, the three
+  // solved together, and a point that touched one wall covered for the others.
+  weights_[0] = weights_[0].cwiseMax(weights_[1]).cwiseMax(weights_[2]);
+  // Covered (every wanted weight factored) and few stale weights (factored, no longer wanted:
+  // the point left): the factors stay. Stale weights cost convergence, not correctness (the
+  // residual is exact), so they go only when they outnumber the wanted ones.
+  const Eigen::VectorXd& factored = factoredWeights_[factorOf_[0]];
+  const bool grows = (weights_[0].array() > factored.array()).any();
+  const long stale = (factored.array() > weights_[0].array()).count();
+  const long wanted = (weights_[0].array() > 0.0).count();
+  const bool drop = stale > std::max(kStaleFloor, wanted);
+  if (!grows && !drop) {
+    for (int c = 0; c < 3; ++c) weights_[c] = factoredWeights_[factorOf_[c]];
+    return false;
+  }
+  if (!drop) weights_[0] = weights_[0].cwiseMax(factored);
+  weights_[1] = weights_[0];
+  weights_[2] = weights_[0];
+  return true;
 }
 
 StepResult ProjectiveIntegrator::factorChanged(double h) {
@@ -179,6 +223,12 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
       v[i] = (x[i] - x0[i]) * inverseH;
     }
   }
+  // The contact weights for this step: factored afresh only when a point about to touch is not
+  // covered, or stale weights have piled up (planWeights).
+  const bool plan = !barrier && options_.coverContacts;
+  if ((plan && planWeights(model, x0, v0, h)) || !factored_ || h != h_) {
+    if (StepResult res = factorChanged(h); !res.ok) return res;
+  }
   int iterations = 0;
   chebyshev_.start();  // ProjectiveOptions::chebyshevRho
   for (; iterations < options_.iterations; ++iterations) {
@@ -186,18 +236,32 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
     // Local step inside the force evaluation (damping, field and user force at the iterate,
     // v = (x - x0)/h); on each block of points once its forces are final, the global step's
     // right-hand side -r = f - M (x - y)/h^2 and the contact weights at x, in the same pass.
-    std::atomic<bool> weightsDiffer{false};  // from those of the factor a coordinate uses
+    std::atomic<long> uncovered{0};  // weights above those of the factor its coordinate uses
     model.forces(x, v, f_.data(), [&](std::ptrdiff_t lo, std::ptrdiff_t hi) {
       for (std::ptrdiff_t c = 0; c < 3; ++c) {
         for (std::ptrdiff_t i = c * n + lo; i < c * n + hi; ++i) {
           d[i] = f[i] - inertia * (x[i] - y[i]);
         }
       }
-      if (contactWeights(model, x, lo, hi)) weightsDiffer.store(true, std::memory_order_relaxed);
+      if (const long count = contactWeights(model, x, lo, hi)) {
+        uncovered.fetch_add(count, std::memory_order_relaxed);
+      }
     });
-    const bool changed = weightsDiffer.load(std::memory_order_relaxed) && factored_ && h == h_;
-    if (changed) ++contactChanges_;
-    if (!factored_ || h != h_ || changed) {
+    // A point touched that the factor does not cover: its weight joins (the others stay).
+    const long missed = uncovered.load(std::memory_order_relaxed);
+    const bool changed = missed > 0;
+    if (changed) {
+      ++contactChanges_;
+      if (options_.coverContacts) {
+        // Every coordinate's factor takes the largest weight any coordinate misses.
+        Eigen::VectorXd& all = weights_[0];
+        all = factoredWeights_[factorOf_[0]];
+        for (int c = 0; c < 3; ++c) all = all.cwiseMax(wanted_[c]);
+        weights_[1] = all;
+        weights_[2] = all;
+      } else {
+        for (int c = 0; c < 3; ++c) weights_[c] = wanted_[c];
+      }
       if (StepResult res = factorChanged(h); !res.ok) return res;
     }
     // Global step: A_c delta_c = -r_c, the coordinates that share a factor solved together.

@@ -15,19 +15,24 @@
 //   Laplacian),
 // W_c diagonal: kc for each wall a point violates along coordinate c (its exact Hessian), and kc
 // for each plane or sphere contact on all three coordinates (kc I >= kc n n^T, so every
-// iteration still lowers the projective energy). A is factored with CHOLMOD once per scene and
-// step size, and again only for a coordinate whose contact set changed (a change of a few
-// points by CHOLMOD's rank-one updates and downdates of the factor, cholmod_updown); the factor
-// is shared between coordinates whose matrices are equal. Spring and contact damping, the force
-// field and the user force are evaluated at the iterate (lagged one iteration): at the fixed point
-// they are exactly where backward Euler evaluates them, so the iterations converge to the
-// `implicit` step, damping included (the lag converges because h c/(m + k h^2) << 1).
-// With barrier contact the barrier's force is evaluated at the iterate like the others (no
-// contact weights: no point is ever inside), and each update is cut to 0.9 of the largest that
-// keeps every point outside every solid (Model::contactStepBound), counted in barrier_cuts.
-// Options: iterations per step (10) and a tolerance (m): the iterations stop early when an
-// update moves no coordinate more than it (0: always all iterations); Chebyshev acceleration
-// (ProjectiveOptions::chebyshevRho).
+// iteration still lowers the projective energy). The residual r is exact whatever W is, so W
+// only has to cover the contacts (ProjectiveOptions::coverContacts, off by default) (W_c >= each
+// contact's Hessian: a contact W misses can make the iteration diverge, a weight on a free point
+// only slows it): W is planned at the step's start to cover the contacts at x0, at y and a step
+// beyond (a point about to touch is covered before it does), grows when an iterate touches a point
+// it misses, and keeps the weights of points that left until they outnumber the wanted ones. A is
+// factored with CHOLMOD once per scene and step size, and again only for a coordinate whose weights
+// changed (a change of a few points by CHOLMOD's rank-one updates and downdates of the factor,
+// cholmod_updown); the factor is shared between coordinates whose matrices are equal. Spring and
+// contact damping, the force field and the user force are evaluated at the iterate (lagged one
+// iteration): at the fixed point they are exactly where backward Euler evaluates them, so the
+// iterations converge to the `implicit` step, damping included (the lag converges because h c/(m +
+// k h^2) << 1). With barrier contact the barrier's force is evaluated at the iterate like the
+// others (no contact weights: no point is ever inside), and each update is cut to 0.9 of the
+// largest that keeps every point outside every solid (Model::contactStepBound), counted in
+// barrier_cuts. Options: iterations per step (10) and a tolerance (m): the iterations stop early
+// when an update moves no coordinate more than it (0: always all iterations); Chebyshev
+// acceleration (ProjectiveOptions::chebyshevRho).
 #pragma once
 
 #include <Eigen/Core>
@@ -62,9 +67,15 @@ class ProjectiveIntegrator final : public Integrator {
 
  private:
   void bind(const Model& model);
-  // The contact weights of every coordinate at positions x (3n) for the points [lo, hi); true
-  // when one differs from the weights of the factor its coordinate uses.
-  bool contactWeights(const Model& model, const double* x, std::ptrdiff_t lo, std::ptrdiff_t hi);
+  // Each obstacle's contact weights at positions x (3n) of the points [lo, hi), into w.
+  void weightsAt(const Model& model, const double* x, std::ptrdiff_t lo, std::ptrdiff_t hi,
+                 const std::array<double*, 3>& w) const;
+  // The contact weights at x into wanted_ for the points [lo, hi); the number above the weights
+  // of the factor their coordinate uses (ProjectiveOptions::coverContacts; off: different).
+  long contactWeights(const Model& model, const double* x, std::ptrdiff_t lo, std::ptrdiff_t hi);
+  // The weights for a step from x0 at velocity v0 into weights_; true when they differ from
+  // the factored ones (a point about to touch is not covered, or stale weights are dropped).
+  bool planWeights(const Model& model, const double* x0, const double* v0, double h);
   StepResult factorChanged(double h);
 
   ProjectiveOptions options_;
@@ -74,13 +85,15 @@ class ProjectiveIntegrator final : public Integrator {
   double mass_ = 0.0;
   double h_ = 0.0;  // the step size the factors are for
   std::unique_ptr<SpringLaplacian> laplacian_;
-  std::array<SparseMatrix, 3> A_;                             // per coordinate: M/h^2 + L + W_c
-  std::array<Eigen::VectorXd, 3> weights_, factoredWeights_;  // W_c: wanted, factored
+  std::array<SparseMatrix, 3> A_;  // per coordinate: M/h^2 + L + W_c
+  // W_c: to factor, wanted at the iterate, factored
+  std::array<Eigen::VectorXd, 3> weights_, wanted_, factoredWeights_;
   std::array<int, 3> factorOf_{{0, 1, 2}};  // which coordinate's factor each one uses
   struct Factors;                           // CHOLMOD's, one per distinct matrix
   std::unique_ptr<Factors> factors_;
   bool factored_ = false;
   Eigen::VectorXd y_, x_, v_, f_, previous_;  // previous_: the iterate before x_; v_: (x_ - x0)/h
+  Eigen::VectorXd ahead_;                     // planWeights' positions
   Eigen::MatrixXd delta_;                     // n x 3, the update of each coordinate
   int lastIterations_ = 0;
   double lastUpdate_ = 0.0;
