@@ -273,6 +273,7 @@ TEST(Projective, CoveringContactWeightsTakeTheSameStepsWithFewerFactorChanges) {
   const double changesA = covering.at("factorizations") + covering.at("factor_updates");
   const double changesB = exact.at("factorizations") + exact.at("factor_updates");
   const double apart = (a.x - b.x).cwiseAbs().maxCoeff();
+  // Shown for the README's figures; asserted below.
   std::printf("thrown at the floor: %g factor changes covering, %g exact, %.3g m apart\n", changesA,
               changesB, apart);
   EXPECT_LT(changesA, changesB / 2.0);

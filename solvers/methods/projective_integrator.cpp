@@ -226,7 +226,7 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
   // The contact weights for this step: factored afresh only when a point about to touch is not
   // covered, or stale weights have piled up (planWeights).
   const bool plan = !barrier && options_.coverContacts;
-  if ((plan && planWeights(model, x0, v0, h)) || !factored_ || h != h_) {
+  if (plan && planWeights(model, x0, v0, h)) {
     if (StepResult res = factorChanged(h); !res.ok) return res;
   }
   int iterations = 0;
@@ -250,8 +250,8 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
     // A point touched that the factor does not cover: its weight joins (the others stay).
     const long missed = uncovered.load(std::memory_order_relaxed);
     const bool changed = missed > 0;
+    if (changed && factored_ && h == h_) ++contactChanges_;
     if (changed) {
-      ++contactChanges_;
       if (options_.coverContacts) {
         // Every coordinate's factor takes the largest weight any coordinate misses.
         Eigen::VectorXd& all = weights_[0];
@@ -262,6 +262,8 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
       } else {
         for (int c = 0; c < 3; ++c) weights_[c] = wanted_[c];
       }
+    }
+    if (changed || !factored_ || h != h_) {  // the first factor, a new h, or new weights
       if (StepResult res = factorChanged(h); !res.ok) return res;
     }
     // Global step: A_c delta_c = -r_c, the coordinates that share a factor solved together.
