@@ -61,17 +61,21 @@ std::optional<std::string> describeDivergence(const StateScan& scan, double boun
 
 }  // namespace
 
+bool energySwings(IntegratorKind kind) {
+  return kind == IntegratorKind::Symplectic || kind == IntegratorKind::Euler;
+}
+
 std::optional<std::string> findDivergence(const State& s, double bound, double speedBound) {
   return describeDivergence(scanPoints(s, 0, s.x.size() / 3), bound, speedBound);
 }
 
 double Simulation::energyBudget() const {
-  return kEnergyGrowthFactor * energyEnvelope_ + kEnergyFloor;
+  return kEnergyGrowthFactor * energyEnvelope_ + kEnergyFloor + kWorkUncertainty * workMoved_;
 }
 
 std::optional<std::string> Simulation::energyGrowth() {
   const double now = model_.energy(state_).total() - externalWork();
-  const bool swings = isExplicit(integrator_->kind());
+  const bool swings = energySwings(integrator_->kind());
   if (swings && steps_ - envelopeStart_ <= kEnergyEnvelopeSteps) {
     energyEnvelope_ = std::max(energyEnvelope_, now);
     return std::nullopt;
@@ -81,7 +85,12 @@ std::optional<std::string> Simulation::energyGrowth() {
   os << "the energy grew to " << now << " J (energy bound " << kEnergyGrowthFactor << " x its "
      << (swings ? "envelope " : "start's ") << energyEnvelope_ << " J";
   if (swings) os << ", the largest of its first " << kEnergyEnvelopeSteps << " steps";
-  os << ", + " << kEnergyFloor << " J, net of the field's, the user force's and friction's work)";
+  os << ", + " << kEnergyFloor << " J";
+  if (workMoved_ > 0.0) {
+    os << " + " << kWorkUncertainty << " x the " << workMoved_
+       << " J of work the field and the user force did";
+  }
+  os << ", net of the field's, the user force's and friction's work)";
   return os.str();
 }
 
@@ -169,18 +178,45 @@ StepResult Simulation::step() {
   ++steps_;
   if (!broken) {
     // The work of the forces no potential describes, only for scenes that have them.
-    if (model_.hasField()) fieldWork_ += model_.fieldWork(previous_.x.data(), state_.x.data());
-    if (model_.hasUserForce()) userWork_ += model_.userForceWork(previous_.x, state_.x);
-    if (model_.hasFriction()) frictionWork_ += model_.frictionWork(previous_, state_);
+    addStepWork();
     if (steps_ - envelopeStart_ <= kEnergyEnvelopeSteps || steps_ % kEnergyCheckInterval == 0) {
       broken = energyGrowth();
     }
   }
   if (!broken) broken = obstacleDistance();
   if (!broken) return result;
+  return diverged(*broken);
+}
+
+void Simulation::addStepWork() {
+  if (model_.hasField()) {
+    const double work = model_.fieldWork(previous_.x.data(), state_.x.data());
+    fieldWork_ += work;
+    workMoved_ += std::abs(work);
+  }
+  if (model_.hasUserForce()) {
+    const double work = model_.userForceWork(previous_.x, state_.x);
+    userWork_ += work;
+    workMoved_ += std::abs(work);
+  }
+  if (model_.hasFriction()) frictionWork_ += model_.frictionWork(previous_, state_);
+}
+
+StepResult Simulation::diverged(const std::string& reason) {
   state_ = previous_;
-  divergence_ = Divergence{state_.t, steps_, integrator_->kind(), *broken};
+  divergence_ = Divergence{state_.t, steps_, integrator_->kind(), reason};
   return StepResult::failure(divergence_->describe());
+}
+
+StepResult Simulation::checkEnergy() {
+  if (divergence_) return StepResult::failure(divergence_->describe());
+  // A state just checked by step() (or the start) needs nothing more.
+  if (steps_ == 0 || steps_ - envelopeStart_ <= kEnergyEnvelopeSteps ||
+      steps_ % kEnergyCheckInterval == 0) {
+    return StepResult::success();
+  }
+  if (std::optional<std::string> broken = energyGrowth()) return diverged(*broken);
+  return StepResult::success();
 }
 
 std::optional<std::string> Simulation::obstacleDistance() {
@@ -221,6 +257,7 @@ void Simulation::stateEdited() {
   integrator_->restart();
   if (divergence_ && !findDivergence(state_)) divergence_.reset();
   energyEnvelope_ = std::max(0.0, model_.energy(state_).total() - externalWork());
+  workMoved_ = 0.0;  // the envelope holds what the work's quadrature missed until now
   envelopeStart_ = steps_;
 }
 

@@ -104,6 +104,13 @@ TEST(JelloSim, ReportsDivergenceWithExitCodeThreeAndWritesNoWorld) {
   EXPECT_TRUE(contains(r.output, "integrator rk4")) << r.output;
   EXPECT_FALSE(contains(r.output, "nan")) << r.output;
   EXPECT_FALSE(std::filesystem::exists(out));
+  // A growth that a 50-step run ended inside with exit 0 (RK4 just past its limit, energy up
+  // 70x): a divergence now, and nothing is saved.
+  const Outcome slow = run(sim() + " " + world("stiff-k1e4.w") +
+                           " --integrator rk4 --dt 3.3e-4 --steps 50 -q --out " + out.string());
+  EXPECT_EQ(slow.code, 3) << slow.output;
+  EXPECT_TRUE(contains(slow.output, "the energy grew")) << slow.output;
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 TEST(JelloSim, ImplicitIntegratorsRunTheStiffSceneThatExplicitOnesCannot) {

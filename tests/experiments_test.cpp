@@ -121,18 +121,22 @@ TEST(StabilityAnalysis, TheBlowUpRuleIgnoresABoundedSwingAndCatchesGrowth) {
     largest = std::max(largest, sim.model().energy(sim.state()).total());
   }
   EXPECT_GT(largest, 10.0 * e0) << "the swing a start-referenced rule fires on";
+  EXPECT_TRUE(sim.checkEnergy().ok) << "the simulation's rule (an envelope of 16 steps)";
   const Trial below = runTrial(w, IntegratorKind::Symplectic, 1.9 / wMax, rule);
   EXPECT_FALSE(below.blewUp) << below.reason;
   EXPECT_EQ(below.steps, std::lround(10.0 / (1.9 / wMax)));
   const Trial above = runTrial(w, IntegratorKind::Symplectic, 2.1 / wMax, rule);
   EXPECT_TRUE(above.blewUp);
   EXPECT_LT(above.steps, 1000);
-  // The free scene, nonlinear, at the same h w_max: a real blow-up, by position.
+  // The free scene, nonlinear, at the same h w_max: a real blow-up, a point far out or fast
+  // (the simulation's bounds: measured 509 m/s against a speed bound of 340 m/s at step 47).
   const World pulled = stabilityScene("free", 10.0, 1e-5);
   const double wPulled = maxAngularFrequency(Model(pulled), initialState(pulled));
   const Trial real = runTrial(pulled, IntegratorKind::Symplectic, 1.9 / wPulled, rule);
   EXPECT_TRUE(real.blewUp);
-  EXPECT_NE(real.reason.find("position bound"), std::string::npos) << real.reason;
+  EXPECT_TRUE(real.reason.find("position bound") != std::string::npos ||
+              real.reason.find("speed bound") != std::string::npos)
+      << real.reason;
 }
 
 // Explicit methods run at least minSteps steps: RK4 at k = 10 just past its limit (h w_max 1.05

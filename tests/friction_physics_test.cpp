@@ -19,9 +19,12 @@
 
 #include "solvers/simulation.h"
 #include "src/world/scene_builder.h"
+#include "tests/test_support.h"
 
 namespace jello {
 namespace {
+
+using test::centre;
 
 constexpr double kG = 9.81;
 constexpr double kPi = 3.14159265358979323846;
@@ -56,13 +59,6 @@ World onTheIncline(World w, double theta, const Vec3& foot, double gap) {
     p = foot + t * r.x + Vec3{0.0, 1.0, 0.0} * r.y + n * (r.z + gap);
   }
   return w;
-}
-
-Vec3 centre(const State& s) {
-  Vec3 c{0, 0, 0};
-  const int n = s.numPoints();
-  for (int p = 0; p < n; ++p) c = c + s.position(p);
-  return c * (1.0 / n);
 }
 
 Vec3 meanVelocity(const State& s) {

@@ -69,6 +69,13 @@ State pointAt(const Vec3& x, const Vec3& v) {
   return s;
 }
 
+Vec3 centre(const State& s) {
+  Vec3 c{0, 0, 0};
+  const int n = s.numPoints();
+  for (int p = 0; p < n; ++p) c = c + s.position(p);
+  return c * (1.0 / n);
+}
+
 ModelSpec singleSpring(double stiffness, double damping, double rest, double mass) {
   ModelSpec spec;
   spec.numPoints = 2;

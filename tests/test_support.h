@@ -42,6 +42,8 @@ ModelSpec singleSpring(double stiffness, double damping, double rest, double mas
 ModelSpec onePoint(const ContactConstants& k);
 // The state of one point at x moving at v.
 State pointAt(const Vec3& x, const Vec3& v);
+// The mean of the points' positions (m): the centre of mass of equal masses.
+Vec3 centre(const State& s);
 
 // Two points of mass m joined by a spring of rest length 0: the force k (x_j - x_i) is exactly
 // linear, so the relative motion is an undamped isotropic oscillator with w = sqrt(2k/m). The

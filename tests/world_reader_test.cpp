@@ -225,6 +225,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadInput{"CubeTwice", 0, "", 0, "cube 8\ncube 8\n", 1041, "cube", "given twice"},
         BadInput{"SixConstants", 3, "200 0.25 400 0.25 0.25 0.25", 0, "", 3, "0.25",
                  "holds more numbers than the four constants"},
+        // The "dt n" line twice: the numbers after it read one place off, the plane flag
+        // failing on line 5; the line to blame is the repeated one, 3.
+        BadInput{"RepeatedDtLine", 3, "0.0005 1\n200 0.25 400 0.25", 0, "", 3, "0.0005",
+                 "holds 2 of the four constants"},
         BadInput{"IntegratorTwice", 0, "", 0, "integrator implicit\nintegrator bdf2\n", 1041,
                  "integrator", "given twice"},
         BadInput{"UnknownIntegratorExtension", 0, "", 0, "integrator Verlet\n", 1040, "Verlet",

@@ -151,8 +151,8 @@ Trial runTrial(const World& world, IntegratorKind kind, double dt, const BlowUpR
       trial.reason = r.message;
       return trial;
     }
-    const bool inEnvelope = explicitMethod && i < kEnergyEnvelopeSteps;  // implicit: the start
-    if (i < kEnergyEnvelopeSteps || (i & 3) == 3 || i + 1 == steps) {
+    const bool inEnvelope = explicitMethod && i < kBlowUpEnvelopeSteps;  // implicit: the start
+    if (i < kBlowUpEnvelopeSteps || (i & 3) == 3 || i + 1 == steps) {
       // Net of the work the force field (the wall scene's load) has done, as the simulation
       // counts it.
       const double e = sim.model().energy(sim.state()).total() - sim.fieldWork();

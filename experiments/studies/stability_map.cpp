@@ -153,7 +153,7 @@ nlohmann::json parameters(const Options& opt, const Study& study) {
            {{"time_s", opt.rule.time},
             {"explicit_min_steps", opt.rule.minSteps},
             {"energy_factor", opt.rule.energyFactor},
-            {"energy_envelope_steps", kEnergyEnvelopeSteps},
+            {"energy_envelope_steps", kBlowUpEnvelopeSteps},
             {"divergence_bound_m", kDivergenceBound}}},
           {"bisection_tolerance", opt.tolerance},
           {"dt_max_s", opt.dtMax},

@@ -184,14 +184,25 @@ void stepAll(Simulation& sim, const Options& opt, Trace& trace, Outcome& o) {
     } else if (r.unconverged && opt.strict) {
       std::ostringstream os;
       os << "step " << sim.steps() << " (to t = " << sim.state().t << " s, integrator " << name
-         << ") did not converge within " << opt.solver.implicit.newtonMaxIterations
-         << " Newton iterations, even as " << (1 << opt.solver.implicit.newtonHalvings)
-         << " sub-steps (--strict)";
+         << ") did not converge within ";
+      if (sim.integratorKind() == jello::IntegratorKind::ImplicitLinear) {
+        os << opt.solver.implicit.contactNewtonIterations
+           << " Newton iterations at a contact onset (--strict)";
+      } else {
+        os << opt.solver.implicit.newtonMaxIterations << " Newton iterations, even as "
+           << (1 << opt.solver.implicit.newtonHalvings) << " sub-steps (--strict)";
+      }
       o.unconverged = os.str();
       break;
     }
     if (sim.steps() % opt.every == 0) trace.row(sim);
     progress.update(i + 1, o.total);
+  }
+  // The last state faces the energy rule too (it checks every few steps): a run never ends
+  // with exit 0 on a state the rule would flag a step later.
+  if (!o.diverged && o.failure.empty() && o.unconverged.empty() && interruptSignal == 0 &&
+      !sim.checkEnergy().ok) {
+    o.diverged = true;
   }
   o.wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (int signo : {SIGINT, SIGTERM, SIGHUP}) jello::setSignalHandler("jello-sim", signo, SIG_DFL);
@@ -200,6 +211,33 @@ void stepAll(Simulation& sim, const Options& opt, Trace& trace, Outcome& o) {
   o.done = o.diverged ? sim.steps() - 1 : sim.steps();  // an unconverged step was taken
   o.end = sim.model().energy(sim.state());
   o.endL = sim.model().angularMomentum(sim.state());
+}
+
+// On standard error: `count` steps were accepted unconverged, and what to do about it.
+void warnUnconverged(const Options& opt, const Simulation& sim, double count) {
+  if (sim.integratorKind() == jello::IntegratorKind::ImplicitLinear) {
+    // Its Newton runs only where contact begins, to a cap of its own: the Newton options do
+    // nothing for it.
+    std::fprintf(stderr,
+                 "jello-sim: warning: %.0f of %ld steps taken were accepted unconverged: at a "
+                 "contact onset implicit-linear iterates at most %d times to a residual of %g, "
+                 "then keeps its step (--strict makes this an error; the converged method: "
+                 "--integrator implicit; a contact whose force has no jump: --contact smooth; "
+                 "solvers/README.md, \"implicit-linear\")\n",
+                 count, sim.steps(), opt.solver.implicit.contactNewtonIterations,
+                 opt.solver.implicit.contactNewtonTolerance);
+    return;
+  }
+  const int halvings = opt.solver.implicit.newtonHalvings;
+  const std::string retried =
+      halvings > 0 ? ", even in sub-steps of 1/" + std::to_string(1 << halvings) : "";
+  std::fprintf(stderr,
+               "jello-sim: warning: %.0f of %ld steps taken were accepted unconverged: Newton "
+               "did not converge within %d iterations%s (raise --newton-iters or "
+               "--newton-halvings; --strict makes this an error; where a point meets a wall "
+               "at speed the penalty's damping force jumps and the step's equations may have "
+               "no root: --contact smooth; solvers/README.md, \"implicit\")\n",
+               count, sim.steps(), opt.solver.implicit.newtonMaxIterations, retried.c_str());
 }
 
 // The summary as JSON (--stats), and on stderr what went wrong: unconverged steps, a signal, a
@@ -242,16 +280,7 @@ nlohmann::json statistics(const Options& opt, const Simulation& sim, const Outco
   for (const jello::Statistic& st : sim.integrator().statistics()) {
     stats["solver"][st.name] = st.value;
     if (st.name == "newton_unconverged_steps" && st.value > 0 && o.unconverged.empty()) {
-      const int halvings = opt.solver.implicit.newtonHalvings;
-      const std::string retried =
-          halvings > 0 ? ", even in sub-steps of 1/" + std::to_string(1 << halvings) : "";
-      std::fprintf(stderr,
-                   "jello-sim: warning: %.0f of %ld steps taken were accepted unconverged: Newton "
-                   "did not converge within %d iterations%s (raise --newton-iters or "
-                   "--newton-halvings; --strict makes this an error; where a point meets a wall "
-                   "at speed the penalty's damping force jumps and the step's equations may have "
-                   "no root: --contact smooth; solvers/README.md, \"implicit\")\n",
-                   st.value, sim.steps(), opt.solver.implicit.newtonMaxIterations, retried.c_str());
+      warnUnconverged(opt, sim, st.value);
     }
   }
   if (o.interrupted) {

@@ -33,6 +33,15 @@ constexpr int kCorrectionLimit = 128;
 // they outnumber the wanted ones and this many.
 constexpr long kStaleFloor = 16;
 
+// The damping's lag alone converges while the damping's share of the matrix's diagonal is
+// small: h c/(m + k h^2) at most this (SpringLaplacian::dampingRatio, per point, and per contact
+// with kc and dc) keeps A = M/h^2 + L + W and the steps measured before the damping could enter
+// it (jello.w at dt 0.01: 0.12; at its own 5e-4: 1.13, c h/m growing as h falls); above it A
+// carries the damping's Jacobian too (a spectral ratio can be twice the diagonal's). Measured over
+// the grid of projective_test (RunsCleanWhereverBackwardEulerDoesUnderHeavyDamping): kE 25, dE
+// 0.25, dt 1e-3 has 2.9 and diverged at its second step without it.
+constexpr double kDampingInMatrixRatio = 0.25;
+
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -71,8 +80,21 @@ void ProjectiveIntegrator::weightsAt(const Model& model, const double* x, std::p
                                      std::ptrdiff_t hi, const std::array<double*, 3>& w) const {
   for (int c = 0; c < 3; ++c) std::fill(w[c] + lo, w[c] + hi, 0.0);
   for (const auto& obstacle : model.obstacles()) {
-    obstacle->addContactWeights(x, n_, lo, hi, obstacle->constants().stiffness, w);
+    // The contact spring's stiffness, and its damping's velocity Jacobian over h (v = (x - x0)/h)
+    // where the damping is heavy enough to need it (chooseDamping).
+    const ContactConstants& k = obstacle->constants();
+    obstacle->addContactWeights(x, n_, lo, hi, k.stiffness + k.damping * dampingRate_, w);
   }
+}
+
+void ProjectiveIntegrator::chooseDamping(const Model& model, double h) {
+  const double inertia = mass_ / (h * h);
+  double ratio = laplacian_->dampingRatio(inertia, 1.0 / h, 1.0);
+  for (const auto& obstacle : model.obstacles()) {
+    const ContactConstants& k = obstacle->constants();
+    ratio = std::max(ratio, k.damping / h / (inertia + k.stiffness));
+  }
+  dampingRate_ = ratio > kDampingInMatrixRatio ? 1.0 / h : 0.0;
 }
 
 long ProjectiveIntegrator::contactWeights(const Model& model, const double* x, std::ptrdiff_t lo,
@@ -172,8 +194,11 @@ StepResult ProjectiveIntegrator::factorChanged(double h) {
         continue;
       }
     }
-    laplacian_->form(inertia, 0.0, 1.0, weights_[c].data(), A_[c]);
-    // SPD by construction: M/h^2 > 0, L and W semidefinite. The three coordinates' matrices
+    // Heavy damping (chooseDamping): the springs' damping Laplacian over h beside their
+    // stiffness Laplacian, covering its velocity Jacobian ((c/h) u u' per spring, at most
+    // (c/h) I); the damping is evaluated at the iterate, and its lag alone diverged.
+    laplacian_->form(inertia, dampingRate_, 1.0, weights_[c].data(), A_[c]);
+    // SPD by construction: M/h^2 > 0, L, L_c and W semidefinite. The three coordinates' matrices
     // share one pattern: a coordinate factored for the first time borrows another's analysis.
     const PrefactoredCholesky* analyzed = nullptr;
     for (int e = 0; e < 3 && !analyzed; ++e) {
@@ -211,6 +236,7 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
     x[i] = y_[i] = x0[i] + h * v0[i];
     v[i] = (x[i] - x0[i]) * inverseH;
   }
+  if (!factored_ || h != h_) chooseDamping(model, h);  // before any contact weight
   const bool barrier = model.barrierContact();
   if (barrier) {
     // The inertial prediction may lie inside a solid: the iterations start from it pulled back

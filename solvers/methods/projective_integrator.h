@@ -11,11 +11,12 @@
 // which is one solve per coordinate with a matrix that depends only on the springs, h and the
 // contact set:
 //   x_next = x - A^-1 r(x),   r(x) = M (x - y)/h^2 - f(x, (x - x0)/h)   (backward Euler's
-//   residual), A_c = M/h^2 + L + W_c,    L = sum_s k_s (e_a - e_b)(e_a - e_b)^T (the spring
-//   Laplacian),
-// W_c diagonal: kc for each wall a point violates along coordinate c (its exact Hessian), and kc
-// for each plane or sphere contact on all three coordinates (kc I >= kc n n^T, so every
-// iteration still lowers the projective energy). The residual r is exact whatever W is, so W
+//   residual), A_c = M/h^2 + L (+ L_c/h) + W_c,  L = sum_s k_s (e_a - e_b)(e_a - e_b)^T (the
+//   spring Laplacian), L_c the same with the springs' damping c_s,
+// W_c diagonal: kc (+ dc/h) for each wall a point violates along coordinate c (its exact Hessian
+// and its damping's over h), and the same for each plane or sphere contact on all three
+// coordinates (kc I >= kc n n^T, so every iteration still lowers the projective energy); L_c/h
+// and dc/h only under heavy damping (below). The residual r is exact whatever W is, so W
 // only has to cover the contacts (ProjectiveOptions::coverContacts, off by default) (W_c >= each
 // contact's Hessian: a contact W misses can make the iteration diverge, a weight on a free point
 // only slows it): W is planned at the step's start to cover the contacts at x0, at y and a step
@@ -26,11 +27,14 @@
 // cholmod_updown); the factor is shared between coordinates whose matrices are equal. Spring and
 // contact damping, the force field and the user force are evaluated at the iterate (lagged one
 // iteration): at the fixed point they are exactly where backward Euler evaluates them, so the
-// iterations converge to the `implicit` step, damping included (the lag converges because h c/(m +
-// k h^2) << 1). With barrier contact the barrier's force is evaluated at the iterate like the
-// others (no contact weights: no point is ever inside), and each update is cut to 0.9 of the
-// largest that keeps every point outside every solid (Model::contactStepBound), counted in
-// barrier_cuts. Options: iterations per step (10) and a tolerance (m): the iterations stop early
+// iterations converge to the `implicit` step, damping included. The lag converges while the
+// damping's share of A's diagonal is small (h c/(m + k h^2): 0.12 on jello.w); past 0.25, A
+// carries the damping's velocity Jacobian too (L_c/h >= each spring's (c/h) u u', dc/h in W),
+// refactored only when h changes: without it the iteration diverged (kE 25, dE 0.25, dt 1e-3,
+// share 2.9: at its second step). With barrier contact the barrier's force is evaluated at the
+// iterate like the others (no contact weights: no point is ever inside), and each update is cut to
+// 0.9 of the largest that keeps every point outside every solid (Model::contactStepBound), counted
+// in barrier_cuts. Options: iterations per step (10) and a tolerance (m): the iterations stop early
 // when an update moves no coordinate more than it (0: always all iterations); Chebyshev
 // acceleration (ProjectiveOptions::chebyshevRho).
 #pragma once
@@ -67,9 +71,13 @@ class ProjectiveIntegrator final : public Integrator {
 
  private:
   void bind(const Model& model);
-  // Each obstacle's contact weights at positions x (3n) of the points [lo, hi), into w.
+  // Each obstacle's contact weights at positions x (3n) of the points [lo, hi), into w:
+  // kc + dc dampingRate_ (the contact spring, and its damping where A carries it).
   void weightsAt(const Model& model, const double* x, std::ptrdiff_t lo, std::ptrdiff_t hi,
                  const std::array<double*, 3>& w) const;
+  // For a step of h: whether A carries the damping's Jacobian (dampingRate_ 1/h) or the lag
+  // alone converges (0), from the damping's share of A's diagonal.
+  void chooseDamping(const Model& model, double h);
   // The contact weights at x into wanted_ for the points [lo, hi); the number above the weights
   // of the factor their coordinate uses (ProjectiveOptions::coverContacts; off: different).
   long contactWeights(const Model& model, const double* x, std::ptrdiff_t lo, std::ptrdiff_t hi);
@@ -83,7 +91,8 @@ class ProjectiveIntegrator final : public Integrator {
   long modelId_ = -1;
   int n_ = 0;
   double mass_ = 0.0;
-  double h_ = 0.0;  // the step size the factors are for
+  double h_ = 0.0;            // the step size the factors are for
+  double dampingRate_ = 0.0;  // 1/h when A carries the damping, else 0 (chooseDamping)
   std::unique_ptr<SpringLaplacian> laplacian_;
   std::array<SparseMatrix, 3> A_;  // per coordinate: M/h^2 + L + W_c
   // W_c: to factor, wanted at the iterate, factored

@@ -1,5 +1,7 @@
 #include "solvers/system/spring_laplacian.h"
 
+#include <algorithm>
+
 #include "src/base/assertions.h"
 
 namespace jello {
@@ -50,6 +52,13 @@ void SpringLaplacian::form(double d, double a, double b, const double* extra,
   for (std::size_t i = 0; i < nnz; ++i) v[i] = a * damping_[i] + b * k[i];
   const std::size_t n = diagonal_.size();
   for (std::size_t p = 0; p < n; ++p) v[diagonal_[p]] += d + (extra ? extra[p] : 0.0);
+}
+
+double SpringLaplacian::dampingRatio(double d, double a, double b) const {
+  const double* k = stiffness_.valuePtr();
+  double ratio = 0.0;
+  for (const int i : diagonal_) ratio = std::max(ratio, a * damping_[i] / (d + b * k[i]));
+  return ratio;
 }
 
 }  // namespace jello

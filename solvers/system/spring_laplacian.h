@@ -23,6 +23,9 @@ class SpringLaplacian {
 
   // P as above into `out` (given this pattern on first use); extra: n values or null.
   void form(double d, double a, double b, const double* extra, SparseMatrix& out) const;
+  // The largest over the points of a C_pp / (d + b K_pp): how far the damping's diagonal
+  // outweighs the rest of P's (projective's lag of the damping converges when it is small).
+  double dampingRatio(double d, double a, double b) const;
   const SparseMatrix& pattern() const { return stiffness_; }
   int numPoints() const { return static_cast<int>(diagonal_.size()); }
 

@@ -1,6 +1,6 @@
 #include "src/world/world_reader.h"
 
-#include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -237,10 +237,17 @@ void readHeader(Tokenizer& in, const ReaderLimits& limits, World& w) {
   w.dt = in.positive("the time step dt");
   w.stepsPerFrame = in.integer("n (steps per frame)");
   if (w.stepsPerFrame < 1) in.fail(in.lastToken(), "n (steps per frame) must be at least 1");
+  // The line of each constant: a line that holds fewer than four (a repeated "dt n" line) is
+  // where a failure further on started.
+  std::array<Token, 4> constants;
   w.kElastic = in.nonNegative("kElastic");
+  constants[0] = in.lastToken();
   w.dElastic = in.nonNegative("dElastic");
+  constants[1] = in.lastToken();
   w.kCollision = in.nonNegative("kCollision");
+  constants[2] = in.lastToken();
   w.dCollision = in.nonNegative("dCollision");
+  constants[3] = in.lastToken();
   const int constantsLine = in.lastToken().line;
   w.mass = in.positive("the point mass");
   // Line breaks carry no meaning, but a mass on the constants' line usually means that line has
@@ -252,7 +259,22 @@ void readHeader(Tokenizer& in, const ReaderLimits& limits, World& w) {
                 "dCollision: the extra ones were read as the mass and the plane flag)"
           : std::string();
 
-  if (in.integer("the plane flag", flagHint) == 1) {
+  int planeFlag = 0;
+  try {
+    planeFlag = in.integer("the plane flag", flagHint);
+  } catch (const WorldFileError& e) {
+    const int first = constants[0].line;
+    const auto onFirst = std::count_if(constants.begin(), constants.end(),
+                                       [first](const Token& t) { return t.line == first; });
+    if (onFirst == 4) throw;
+    // The constants began on a line too short for them: that line is the mistake.
+    in.fail(constants[0], "line " + std::to_string(first) + " holds " + std::to_string(onFirst) +
+                              " of the four constants kElastic dElastic kCollision dCollision "
+                              "(a repeated 'dt n' line?), so every number after it was read one "
+                              "place off: line " +
+                              std::to_string(e.line()) + " then failed");
+  }
+  if (planeFlag == 1) {
     const Token first = in.next();
     Plane p;
     p.a = in.toNumber(first, "plane a");
