@@ -1,6 +1,7 @@
 #include "solvers/integrator_factory.h"
 
 #include "solvers/cvode/cvode_integrator.h"
+#include "solvers/methods/energy_momentum.h"
 #include "solvers/methods/explicit_integrators.h"
 #include "solvers/methods/linearized_backward_euler.h"
 #include "solvers/methods/newton_integrators.h"

@@ -30,6 +30,13 @@ struct [[nodiscard]] StepResult {
   static StepResult resourceFailure(std::string why) {
     return {false, std::move(why), false, true};
   }
+  // A finished step's result: a success with a sub-step accepted unconverged is counted in
+  // `count` and flagged; anything else is returned as it is.
+  static StepResult counted(StepResult res, bool unconverged, long& count) {
+    if (!res.ok || !unconverged) return res;
+    ++count;
+    return unconvergedSuccess();
+  }
   // The same result, its message prefixed with what failed.
   StepResult within(const std::string& what) const {
     StepResult r = *this;

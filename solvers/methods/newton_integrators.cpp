@@ -157,12 +157,7 @@ StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
   iterations_ += iterations;
   maxIterations_ = std::max<long>(maxIterations_, iterations);
   ++steps_;
-  if (!res.ok) return res;
-  if (stepUnconverged_) {
-    ++unconverged_;
-    return StepResult::unconvergedSuccess();
-  }
-  return res;
+  return StepResult::counted(res, stepUnconverged_, unconverged_);
 }
 
 // One step of h from s by Newton; unconverged, two half steps instead, down to the floor of

@@ -71,7 +71,9 @@ constexpr bool isAStable(LinearModel model) {
     "average-acceleration Newmark (trapezoidal rule): second order, A-stable")                   \
   X(Bdf2, "bdf2", "bdf2", Bdf2, Newton, Bdf2, "second-order BDF, started by backward Euler")     \
   X(Projective, "projective", "projective", ProjectiveIntegrator, Projective, BackwardEuler,     \
-    "backward Euler by prefactored local/global iterations (projective dynamics)")
+    "backward Euler by prefactored local/global iterations (projective dynamics)")               \
+  X(EnergyMomentum, "energy-momentum", "energy-momentum", EnergyMomentum, Newton, Trapezoidal,   \
+    "discrete gradient (Gonzalez): keeps energy and momenta exactly, second order")
 
 enum class IntegratorKind {
 #define JELLO_INTEGRATOR_ENUMERATOR(kind, name, fileName, Class, family, model, summary) kind,
