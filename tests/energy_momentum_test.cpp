@@ -11,32 +11,16 @@
 
 #include "solvers/simulation.h"
 #include "src/world/scene_builder.h"
-#include "tests/newton_test_support.h"
-#include "tests/test_support.h"
+#include "tests/energy_momentum_support.h"
 
 namespace jello {
 namespace {
 
 using test::angularMomentum;
-
-SolverOptions tight() {
-  SolverOptions o;
-  o.implicit.newtonTolerance = 1e-13;
-  o.implicit.newtonPositionTolerance = 1e-15;
-  o.implicit.newtonMaxIterations = 100;
-  return o;
-}
-
-// The spinning, 5% stretched stiff cube with spring damping c (the walls never reached).
-World spinningCube(double k, double c) {
-  SceneSpec spec = vibratingStiffCube(k);
-  spec.dElastic = c;
-  return buildWorld(spec);
-}
-
-long unconvergedSteps(const Integrator& method) {
-  return std::lround(*findStatistic(method.statistics(), "newton_unconverged_steps"));
-}
+using test::expectConserved;
+using test::spinningCube;
+using test::tight;
+using test::unconvergedSteps;
 
 // Each spring's discrete-gradient force does exactly minus the change of its energy over any
 // move (F . (x1 - x0) = -(U(x1) - U(x0))), whatever the move, and is central (no net force).
@@ -58,31 +42,44 @@ TEST(EnergyMomentum, TheSpringsDiscreteGradientDoesExactlyTheirEnergysChange) {
   }
 }
 
-// The undamped spinning stretched cube (the walls never reached), dt = 0.01, far beyond every
-// explicit limit (h w_max 2.7 at k = 1e4 to 27 at 1e6): every step converged, the total energy
-// to 1e-9 of itself and the angular momentum to 1e-10 over `steps` steps (20 here: 100 took
-// 90 s).
-void expectConserved(double k, int steps) {
-  SCOPED_TRACE("k " + std::to_string(k));
-  const World w = spinningCube(k, 0.0);
+// Newton's matrix is the residual's Jacobian: (2/h^2) A p against central differences of r along
+// random directions p, at a state a step into the spinning stretched cube (springs stretched,
+// moving), undamped (exact: the springs' discrete gradient) and damped (the damping taken at the
+// midpoint as the model's Jacobian gives it: without the damping force's change with the springs'
+// directions, a quasi-Newton matrix), each against the change of the forces alone.
+void expectJacobianMatchesDifferences(double c, double tolerance) {
+  SCOPED_TRACE("c " + std::to_string(c));
+  const World w = spinningCube(1e4, c);
   const Model model(w);
-  State s = initialState(w);
+  const State s = initialState(w);
+  const double h = 0.01;
   EnergyMomentum method(tight());
-  const double e0 = model.energy(s).total();
-  const Eigen::Vector3d l0 = angularMomentum(model, s);
-  double worstE = 0.0, worstL = 0.0;
-  for (int i = 0; i < steps; ++i) {
-    ASSERT_TRUE(method.step(model, s, 0.01).ok) << i;
-    worstE = std::max(worstE, std::abs(model.energy(s).total() - e0) / e0);
-    worstL = std::max(worstL, (angularMomentum(model, s) - l0).norm() / l0.norm());
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Eigen::VectorXd x1 = s.x + h * s.v;
+  for (Eigen::Index i = 0; i < x1.size(); ++i) x1[i] += 1e-3 * normal(rng);
+  const SparseMatrix a = method.newtonMatrix(model, s, h, x1);
+  for (int trial = 0; trial < 5; ++trial) {
+    Eigen::VectorXd p(x1.size());
+    for (Eigen::Index i = 0; i < p.size(); ++i) p[i] = normal(rng);
+    const double eps = 1e-6;
+    const Eigen::VectorXd fd =
+        (method.residual(model, s, h, x1 + eps * p) - method.residual(model, s, h, x1 - eps * p)) /
+        (2.0 * eps);
+    const Eigen::VectorXd jp = (2.0 / (h * h)) * (a * p);
+    // Against the forces' part alone (the inertia's 2M/h^2 p is most of r's change).
+    const Eigen::VectorXd forces = fd - (2.0 * model.mass() / (h * h)) * p;
+    std::printf("c %g: off by %.3g of the forces' change\n", c, (jp - fd).norm() / forces.norm());
+    EXPECT_LT((jp - fd).norm(), tolerance * forces.norm()) << "direction " << trial;
   }
-  std::printf("k %g, %d steps: energy within %.3g, angular momentum within %.3g\n", k, steps,
-              worstE, worstL);
-  EXPECT_EQ(unconvergedSteps(method), 0);
-  EXPECT_LT(worstE, 1e-9);   // measured at most 4e-13 over 100 steps
-  EXPECT_LT(worstL, 1e-10);  // measured 9e-13 to 6e-11 over 100 steps: short of 1e-11
 }
 
+TEST(EnergyMomentum, NewtonsMatrixIsTheResidualsJacobian) {
+  expectJacobianMatchesDifferences(0.0, 1e-8);  // measured 6.6e-11
+  expectJacobianMatchesDifferences(5.0, 2e-3);  // measured 8.1e-4
+}
+
+// 20 steps here (a few seconds); 1,000 in the soak run (tests/energy_momentum_soak_test.cpp).
 TEST(EnergyMomentum, KeepsTheEnergyAndAngularMomentumOfTheSpinningStretchedCube) {
   for (double k : {1e4, 1e5, 1e6}) expectConserved(k, 20);
 }

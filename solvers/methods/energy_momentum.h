@@ -19,7 +19,8 @@
 // The step's equations r(x1) = 2M/h^2 (x1 - x0 - h v0) - F(x0, x1) = 0 are solved by Newton
 // from the implicit midpoint's step (its energy merit carries Newton through a start that
 // crushes springs, where |r| as a merit stalls), with the springs' exact discrete-gradient
-// Jacobian (not symmetric: sparse LU) and the midpoint's for contact and damping
+// Jacobian (not symmetric: BiCGSTAB, preconditioned by the midpoint's symmetric matrix factored
+// by CHOLMOD; a sparse LU where it stalls) and the midpoint's for contact and damping
 // (2M/h^2 - K/2 - D/h at x_m), and a backtracking line search on |r|. Newton stops at the relative
 // residual ImplicitOptions::newtonTolerance (|r| over |2M/h^2 (x1 - x0 - h v0)| + |F|) or when an
 // update moves no coordinate more than newtonPositionTolerance; at newtonMaxIterations the step is
@@ -28,14 +29,16 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <Eigen/SparseLU>
 #include <memory>
 
 #include "solvers/integrator.h"
+#include "solvers/linalg/linear_solver.h"
 #include "solvers/methods/newton_integrators.h"
 #include "solvers/system/jacobian.h"
 
 namespace jello {
+
+struct SparseLuFallback;  // energy_momentum.cpp
 
 class EnergyMomentum final : public Integrator {
  public:
@@ -51,6 +54,9 @@ class EnergyMomentum final : public Integrator {
                            const Eigen::VectorXd& x1);
   // The discrete-gradient spring force F(x0, x1) alone (N, 3n), for tests.
   static void springForces(const Model& model, const double* x0, const double* x1, double* f);
+  // h^2/2 dr/dx1 at x1 from `start`, the matrix Newton factors: for the finite-difference test.
+  const SparseMatrix& newtonMatrix(const Model& model, const State& start, double h,
+                                   const Eigen::VectorXd& x1);
 
  private:
   void bind(const Model& model);
@@ -64,8 +70,14 @@ class EnergyMomentum final : public Integrator {
   // Springs alone: x1_ changed rigidly (by the order of Newton's residual) so that the step
   // keeps the linear and angular momentum to round-off.
   void keepMomenta(const Model& model, const State& s, double h);
-  // Factors h^2/2 of the Newton matrix at x1_ (its midpoint xm_ last evaluated).
-  StepResult factor(const Model& model, const State& s, double h);
+  // h^2/2 of the Newton matrix at x1_ (its midpoint xm_ last evaluated) into A_, and its
+  // symmetric midpoint part into S_.
+  void assemble(const Model& model, const State& s, double h);
+  // S_ factored (CHOLMOD), the preconditioner of the next solves.
+  StepResult factor();
+  // delta_ = -A_^-1 (h^2/2) r_ by BiCGSTAB preconditioned by S_'s factor, to a relative residual
+  // of `tolerance`.
+  StepResult solveNewton(double h, double tolerance);
 
   ImplicitOptions options_;
   // The implicit midpoint step, whose energy merit carries Newton through the strongly
@@ -76,7 +88,12 @@ class EnergyMomentum final : public Integrator {
   long modelId_ = -1;
   std::unique_ptr<JacobianAssembler> jacobian_;
   SparseMatrix A_;
-  Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>> lu_;
+  // A_ the exact Newton matrix, S_ its symmetric part as the midpoint's (clamped: SPD), factored
+  // by CHOLMOD as BiCGSTAB's preconditioner.
+  SparseMatrix S_;
+  std::unique_ptr<SpdSolver> spd_;
+  std::unique_ptr<SparseLuFallback> lu_;  // where BiCGSTAB stalls
+  long krylovIterations_ = 0, luFallbacks_ = 0;
   Eigen::VectorXd x1_, trial_, r_, delta_, xm_, vm_, f_, fRest_, fSprings_, work_;
   bool stepUnconverged_ = false;
   bool springDamping_ = false;  // any spring with damping
