@@ -6,8 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <limits>
+#include <stdexcept>
 
 #include "solvers/simulation.h"
+#include "src/base/out_of_memory.h"
 #include "src/world/scene_builder.h"
 #include "tests/test_support.h"
 
@@ -18,6 +20,23 @@ TEST(Assertions, AbortNamingTheConditionWhenOn) {
   if (!kJelloAssertions) GTEST_SKIP() << "assertions are off in this build";
   EXPECT_DEATH(JELLO_ASSERT(1 + 1 == 3, "arithmetic"),
                "assertion failed: 1 \\+ 1 == 3 \\(arithmetic\\)");
+}
+
+// An exception nobody caught (a library's, where no main expected one) is named and ends with
+// exit 1, not a silent SIGABRT (jello-work-precision --drift-k 1e308 aborted with 134 and
+// printed nothing).
+TEST(Assertions, AnUncaughtExceptionIsNamedAndExitsOne) {
+  EXPECT_EXIT(
+      {
+        exitCleanlyWhenOutOfMemory("jello-test");
+        try {
+          throw std::runtime_error("TridiagEigen: eigen decomposition failed");
+        } catch (...) {
+          std::terminate();  // what an exception escaping main does
+        }
+      },
+      ::testing::ExitedWithCode(1),
+      "jello-test: error: unexpected failure: TridiagEigen: eigen decomposition failed");
 }
 
 TEST(Assertions, EvaluateNothingWhenOff) {

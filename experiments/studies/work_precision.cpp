@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <iostream>
 #include <optional>
+#include <sstream>
 
 #include "experiments/studies/csv_table.h"
 #include "experiments/studies/drift.h"
@@ -378,7 +379,15 @@ int main(int argc, char** argv) {
   }
   const std::vector<Task> tasks = tasksOf(scenes, opt, rtols, study.quick);
   const World driftWorld = driftScene(opt.drift);
-  const std::vector<DriftRun> driftRuns = driftPlan(driftWorld, opt.drift, study.quick);
+  std::vector<DriftRun> driftRuns;
+  try {
+    driftRuns = driftPlan(driftWorld, opt.drift, study.quick);
+  } catch (const std::exception& e) {
+    // Spectra's eigensolver throws on a lattice it cannot resolve (--drift-k 1e308 or 1e-300).
+    std::ostringstream what;
+    what << "the drift runs (--drift-k " << opt.drift.k << ") could not be planned: " << e.what();
+    return study.fail(what.str());
+  }
 
   CsvTable table = precisionTable(), damping = dampingTable();
   CsvTable driftSeries = driftSeriesTable(), driftSummary = driftSummaryTable();

@@ -362,12 +362,20 @@ bool writeOutputs(const Options& opt, const Simulation& sim, const Outcome& o, c
 }
 
 int run(const Options& opt) {
-  // Every output is checked before the run (an I/O failure, found before it starts).
+  // Every output is checked before the run: an I/O failure (exit 1) or two outputs naming one
+  // file (exit 2), found before it starts.
   std::vector<jello::PlannedOutput> outputs;
   if (opt.outGiven) outputs.push_back({"--out", opt.out});
   if (opt.statsGiven) outputs.push_back({"--stats", opt.stats});
   if (opt.traceGiven) outputs.push_back({"--trace", opt.trace});
-  if (!jello::checkOutputs("jello-sim", outputs)) return kExitInput;
+  switch (jello::checkOutputs("jello-sim", outputs)) {
+    case jello::OutputCheck::Ok:
+      break;
+    case jello::OutputCheck::Unwritable:
+      return kExitInput;
+    case jello::OutputCheck::SameFile:
+      return kExitUsage;
+  }
   std::optional<jello::World> world = loadWorld(opt);
   if (!world) return kExitInput;
   if (std::string error = jello::applyContactFlags(opt.contact, world->contact, world->kCollision);

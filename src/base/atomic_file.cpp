@@ -199,6 +199,19 @@ void writeFileAtomically(const std::filesystem::path& path, std::string_view con
   tmp.commit();
 }
 
+std::filesystem::path writtenFile(const std::filesystem::path& path) {
+  std::error_code ec;
+  std::filesystem::path file = std::filesystem::absolute(path, ec);
+  if (ec) return path;
+  try {
+    file = followLinks(file);
+  } catch (const std::exception&) {
+    return file;  // a loop or an unreadable link: the write itself reports it
+  }
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(file, ec);
+  return ec ? file : canonical;
+}
+
 std::string outputProblem(const std::filesystem::path& path) {
   if (path.empty()) return "the output path is empty";
   std::error_code ec;

@@ -31,6 +31,11 @@ void writeFileAtomically(const std::filesystem::path& path, std::string_view con
 // or an empty string: for programs to check every output before a long run.
 std::string outputProblem(const std::filesystem::path& path);
 
+// The file writeFileAtomically(path, ...) would write, as an absolute path with every symbolic
+// link resolved (a dangling link's missing target included): two outputs that resolve to one
+// file would overwrite each other. The path made absolute where its links cannot be read.
+std::filesystem::path writtenFile(const std::filesystem::path& path);
+
 namespace testing {
 // Called, when set, right after the temporary file is created: a test raises a signal there.
 extern void (*afterTemporaryCreated)();

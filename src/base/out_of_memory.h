@@ -1,6 +1,7 @@
 // What every program does when memory runs out: a clear message and exit code 1, wherever the
 // allocation failed (a world's springs, a solver's factor, a table), instead of an uncaught
-// std::bad_alloc aborting with 134. Installed first thing in each main().
+// std::bad_alloc aborting with 134; and any other uncaught exception, named, exit 1. Installed
+// first thing in each main().
 #pragma once
 
 #include <unistd.h>
@@ -26,15 +27,27 @@ inline void onOutOfMemory() {
 }
 
 // A std::bad_alloc nobody caught (Eigen and CHOLMOD's wrappers throw it without going through
-// operator new, so the new-handler never sees them) ends the same way.
+// operator new, so the new-handler never sees them) ends the same way. Any other exception
+// nobody caught (a library's, thrown where no main expected one) is named and ends with exit 1,
+// never a silent SIGABRT; only a terminate without an exception (a programming error) aborts.
 inline void onTerminate() {
   if (const std::exception_ptr e = std::current_exception()) {
+    const char* what = "an exception of unknown type";
     try {
       std::rethrow_exception(e);
     } catch (const std::bad_alloc&) {
       onOutOfMemory();
+    } catch (const std::exception& ex) {
+      what = ex.what();
     } catch (...) {
     }
+    const char* p = outOfMemoryProgram;
+    const char head[] = ": error: unexpected failure: ";
+    [[maybe_unused]] ssize_t a = ::write(STDERR_FILENO, p, std::strlen(p));
+    [[maybe_unused]] ssize_t b = ::write(STDERR_FILENO, head, sizeof head - 1);
+    [[maybe_unused]] ssize_t c = ::write(STDERR_FILENO, what, std::strlen(what));
+    [[maybe_unused]] ssize_t d = ::write(STDERR_FILENO, "\n", 1);
+    std::_Exit(1);
   }
   std::abort();
 }
