@@ -137,6 +137,15 @@ TEST(ReferenceFile, ReadsBackToTheBitAndRefusesAnythingElse) {
   writeTrajectory(file, key, fits, &s);
   why = refusal(file, replaced(slurp(file), "state 0.040000000000000001 8", "state 0.04 9"), key);
   EXPECT_NE(why.find("a state of 9 points, not 8"), std::string::npos) << why;
+
+  // A token carrying terminal escapes (a title, a screen clear) is quoted escaped: no control
+  // byte reaches the terminal.
+  why = refusal(file, replaced(good, "scene falling", "scene \x1b]0;owned\x07\x1b[2J"), key);
+  EXPECT_NE(why.find("made for the scene '\\x1b]0;owned\\x07\\x1b[2J', not 'falling'"),
+            std::string::npos)
+      << why;
+  EXPECT_EQ(why.find('\x1b'), std::string::npos) << why;
+  EXPECT_EQ(why.find('\x07'), std::string::npos) << why;
 }
 
 // A reference computed at once, computed into a directory, read back from it, and resumed from

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "src/base/atomic_file.h"
+#include "src/world/world_reader.h"
 
 namespace jello::experiments {
 
@@ -46,7 +47,7 @@ class Lines {
   void expect(std::size_t count, const std::string& name = "") {
     if (!next()) fail("the file ends early" + (name.empty() ? "" : ", before '" + name + "'"));
     if (!name.empty() && tokens_[0] != name) {
-      fail("'" + tokens_[0] + "' where '" + name + "' was expected");
+      fail(quoted(0) + " where '" + name + "' was expected");
     }
     if (tokens_.size() != count) {
       fail(std::to_string(tokens_.size()) + " tokens where " + std::to_string(count) +
@@ -56,6 +57,13 @@ class Lines {
 
   std::size_t size() const { return tokens_.size(); }
   const std::string& token(std::size_t i) const { return tokens_[i]; }
+  // Token i as a message quotes it, 'TOKEN' (no terminal escapes: src/world/world_reader.h).
+  std::string quoted(std::size_t i) const { return quote(tokens_[i]); }
+  static std::string quote(const std::string& token) {
+    std::string q(1, '\'');
+    q.append(displayToken(token)).push_back('\'');
+    return q;
+  }
 
   double number(std::size_t i) const {
     const std::string& t = tokens_[i];
@@ -63,7 +71,7 @@ class Lines {
     errno = 0;
     const double v = std::strtod(t.c_str(), &end);
     if (end == t.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
-      fail("'" + t + "' is not a finite number");
+      fail(quote(t) + " is not a finite number");
     }
     return v;
   }
@@ -71,13 +79,14 @@ class Lines {
   long count(std::size_t i, long most) const {
     const double v = number(i);
     if (v < 0.0 || v > double(most) || v != std::floor(v)) {
-      fail("'" + tokens_[i] + "' is not a count from 0 to " + std::to_string(most));
+      fail(quoted(i) + " is not a count from 0 to " + std::to_string(most));
     }
     return long(v);
   }
 
   [[noreturn]] void fail(const std::string& what) const {
-    throw std::runtime_error(file_.string() + ":" + std::to_string(number_) + ": " + what);
+    throw std::runtime_error(displayToken(file_.string(), file_.string().size(), true) + ":" +
+                             std::to_string(number_) + ": " + what);
   }
 
  private:
@@ -105,12 +114,12 @@ std::optional<StoredTrajectory> readTrajectory(const std::filesystem::path& file
   Lines lines(file);
   lines.expect(2, "scene");
   if (lines.token(1) != key.scene) {
-    lines.fail("made for the scene '" + lines.token(1) + "', not '" + key.scene + "'");
+    lines.fail("made for the scene " + lines.quoted(1) + ", not '" + key.scene + "'");
   }
   const auto same = [&](const char* name, double wanted) {
     lines.expect(2, name);
     if (lines.number(1) != wanted) {
-      lines.fail(std::string("made for ") + name + " = " + lines.token(1) + ", not " +
+      lines.fail(std::string("made for ") + name + " = " + displayToken(lines.token(1)) + ", not " +
                  exact(wanted));
     }
   };
@@ -133,7 +142,8 @@ std::optional<StoredTrajectory> readTrajectory(const std::filesystem::path& file
     const long points = long(key.n) * key.n * key.n;
     if (lines.size() != 3) lines.fail("'state' takes the time and the number of points");
     if (lines.number(2) != double(points)) {
-      lines.fail("a state of " + lines.token(2) + " points, not " + std::to_string(points));
+      lines.fail("a state of " + displayToken(lines.token(2)) + " points, not " +
+                 std::to_string(points));
     }
     State s;
     s.t = lines.number(1);
@@ -155,8 +165,8 @@ std::optional<StoredTrajectory> readTrajectory(const std::filesystem::path& file
     lines.fail("unfinished (" + std::to_string(stored.fits.size()) + " of " +
                std::to_string(samples) + " fits) and without the state to resume from");
   }
-  if (lines.token(0) != "end") lines.fail("'" + lines.token(0) + "' where 'end' was expected");
-  if (lines.next()) lines.fail("'" + lines.token(0) + "' after 'end'");
+  if (lines.token(0) != "end") lines.fail(lines.quoted(0) + " where 'end' was expected");
+  if (lines.next()) lines.fail(lines.quoted(0) + " after 'end'");
   return stored;
 }
 

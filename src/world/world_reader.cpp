@@ -184,12 +184,9 @@ void readExtensions(Tokenizer& in, Token keyword, World& world, const ReaderLimi
 
 }  // namespace
 
-// A token as a message shows it: at most `limit` bytes (a 50 MB "number" is not repeated),
-// control and non-ASCII bytes as \xNN (no terminal escape codes pass through). File names keep
-// their length and their UTF-8; only control bytes are escaped.
-constexpr std::size_t kShownTokenBytes = 40;
-std::string displayToken(std::string_view token, std::size_t limit = kShownTokenBytes,
-                         bool keepUtf8 = false, std::size_t bytes = 0) {
+// File names keep their length and their UTF-8; only control bytes are escaped.
+std::string displayToken(std::string_view token, std::size_t limit, bool keepUtf8,
+                         std::size_t bytes) {
   bytes = std::max(bytes, token.size());
   std::string out;
   for (std::size_t i = 0; i < token.size() && i < limit; ++i) {

@@ -24,6 +24,14 @@ struct ReaderLimits {
   bool acceptUnknownIntegrator = false;
 };
 
+// A token of a file as a message shows it: at most `limit` bytes (a 50 MB "number" is not
+// repeated, its size said instead), control and non-ASCII bytes as \xNN, so no terminal escape
+// code passes through (keepUtf8: non-ASCII bytes kept, for file names). Every message that quotes
+// a file's content goes through it.
+inline constexpr std::size_t kShownTokenBytes = 40;
+std::string displayToken(std::string_view token, std::size_t limit = kShownTokenBytes,
+                         bool keepUtf8 = false, std::size_t bytes = 0);
+
 class WorldFileError : public std::runtime_error {
  public:
   // `tokenBytes`: the token's full length when `token` holds only its start (0: its own size).
