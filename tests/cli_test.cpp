@@ -712,6 +712,21 @@ TEST(Experiments, AnOptionTheStudyCannotUseIsNamedNotASignal) {
   }
 }
 
+// Values an option's type admits but its study cannot use are refused with their range (exit 2)
+// before the run: jello-stability --time 1e308 overflowed the step count and exited 0 with
+// thresholds from --min-steps alone; --dt-max 4.9e-324 (subnormal) reported stability to it.
+TEST(Experiments, StabilityRefusesTimesAndStepsItCannotRun) {
+  const std::filesystem::path bin = std::filesystem::path(sim()).parent_path();
+  if (!std::filesystem::exists(bin / "jello-stability")) GTEST_SKIP() << "not built here";
+  test::TempDir dir;
+  for (const char* bad : {"--time 1e308", "--time 1e-300", "--dt-max 4.9e-324", "--dt-max 1e300"}) {
+    const Outcome r = run((bin / "jello-stability").string() + " --quick --quiet " + bad +
+                          " --out-dir " + dir.path().string() + " 2>&1");
+    EXPECT_EQ(r.code, 2) << bad << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, "must be at")) << bad << "\n" << r.output;
+  }
+}
+
 // Every numeric option of every program refuses NaN and infinities with exit code 2, found
 // from each program's own --help, so a new option is covered without being listed here.
 TEST(EveryProgram, RefusesNanAndInfinityInEveryNumericOption) {
