@@ -53,6 +53,7 @@ inline void expectConserved(double k, int steps) {
     worstE = std::max(worstE, std::abs(model.energy(s).total() - e0) / e0);
     worstL = std::max(worstL, (angularMomentum(model, s) - l0).norm() / l0.norm());
   }
+  // Shown for the record; asserted just below.
   std::printf("k %g, %d steps: energy within %.3g, angular momentum within %.3g\n", k, steps,
               worstE, worstL);
   EXPECT_EQ(unconvergedSteps(method), 0);

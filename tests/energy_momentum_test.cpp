@@ -69,6 +69,7 @@ void expectJacobianMatchesDifferences(double c, double tolerance) {
     const Eigen::VectorXd jp = (2.0 / (h * h)) * (a * p);
     // Against the forces' part alone (the inertia's 2M/h^2 p is most of r's change).
     const Eigen::VectorXd forces = fd - (2.0 * model.mass() / (h * h)) * p;
+    // Shown for the record; asserted on the next line.
     std::printf("c %g: off by %.3g of the forces' change\n", c, (jp - fd).norm() / forces.norm());
     EXPECT_LT((jp - fd).norm(), tolerance * forces.norm()) << "direction " << trial;
   }

@@ -49,6 +49,7 @@ TEST(Simulation, AFieldPushingACubeFromRestIsNoDivergenceUnderAnyIntegrator) {
     EXPECT_TRUE(sim.checkEnergy().ok) << integratorName(kind);
     // The same motion, to first order.
     const double apart = norm(test::centre(sim.state()) - test::centre(reference.state()));
+    // Shown per integrator for the record; asserted below.
     std::printf("%-16s centre %.3g m from RK4's at 1e-4 s, of %.3g m travelled\n",
                 std::string(integratorName(kind)).c_str(), apart, travel);
     EXPECT_LT(apart, 0.03 * travel) << integratorName(kind);  // measured at most 1.6%

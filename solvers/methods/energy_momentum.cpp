@@ -14,7 +14,6 @@ namespace jello {
 // The fallback where BiCGSTAB stalls: a sparse LU of the exact matrix, its pattern analysed once.
 struct SparseLuFallback {
   Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>> lu;
-  bool analysed = false;
 };
 
 namespace {
@@ -54,51 +53,6 @@ class SpdPreconditioner {
   mutable bool failed_ = false;
 };
 
-}  // namespace
-
-namespace {
-
-// Each spring's elastic force at positions x added to f (3n, component-major), scaled by `sign`,
-// and their energy returned: the model's Hooke law, k (1 - L/l) d on a, for the midpoint terms
-// the discrete gradient replaces.
-double addElasticSpringForces(const Model& model, const double* x, double sign, double* f) {
-  const std::ptrdiff_t n = model.numPoints();
-  double energy = 0.0;
-  for (const Spring& s : model.springs().springs()) {
-    double d[3], l2 = 0.0;
-    for (int c = 0; c < 3; ++c) {
-      d[c] = x[c * n + s.b] - x[c * n + s.a];
-      l2 += d[c] * d[c];
-    }
-    const double l = std::sqrt(l2), scale = s.stiffness * (1.0 - s.rest / l);
-    energy += 0.5 * s.stiffness * (l - s.rest) * (l - s.rest);
-    for (int c = 0; c < 3; ++c) {
-      f[c * n + s.a] += sign * scale * d[c];
-      f[c * n + s.b] -= sign * scale * d[c];
-    }
-  }
-  return energy;
-}
-
-double springEnergy(const Model& model, const double* x) {
-  const std::ptrdiff_t n = model.numPoints();
-  double energy = 0.0;
-  for (const Spring& s : model.springs().springs()) {
-    double l2 = 0.0;
-    for (int c = 0; c < 3; ++c) {
-      const double d = x[c * n + s.b] - x[c * n + s.a];
-      l2 += d * d;
-    }
-    const double stretch = std::sqrt(l2) - s.rest;
-    energy += 0.5 * s.stiffness * stretch * stretch;
-  }
-  return energy;
-}
-
-}  // namespace
-
-namespace {
-
 // BiCGSTAB's relative residual: an inexact Newton step whose error is this fraction of the
 // update, far below what the line search and the stopping test see.
 constexpr double kKrylovTolerance = 1e-8;
@@ -126,7 +80,8 @@ void EnergyMomentum::bind(const Model& model) {
   modelId_ = model.id();
   jacobian_ = std::make_unique<JacobianAssembler>(model);
   springDamping_ = false;
-  for (const Spring& sp : model.springs().springs()) springDamping_ |= sp.damping != 0.0;
+  springs_ = model.springs().springs();
+  for (const Spring& sp : springs_) springDamping_ |= sp.damping != 0.0;
   A_ = jacobian_->pattern();
   S_ = A_;
   spd_ = std::make_unique<SpdSolver>(LinearSolverKind::Cholmod);  // analyses S_'s pattern once
@@ -135,8 +90,12 @@ void EnergyMomentum::bind(const Model& model) {
 
 void EnergyMomentum::springForces(const Model& model, const double* x0, const double* x1,
                                   double* f) {
-  const std::ptrdiff_t n = model.numPoints();
-  for (const Spring& s : model.springs().springs()) {
+  addDiscreteGradient(model.springs().springs(), model.numPoints(), x0, x1, f);
+}
+
+void EnergyMomentum::addDiscreteGradient(const std::vector<Spring>& springs, std::ptrdiff_t n,
+                                         const double* x0, const double* x1, double* f) {
+  for (const Spring& s : springs) {
     double d0[3], d1[3], q0 = 0.0, q1 = 0.0;
     for (int c = 0; c < 3; ++c) {
       d0[c] = x0[c * n + s.b] - x0[c * n + s.a];
@@ -168,7 +127,7 @@ double EnergyMomentum::evaluate(const Model& model, const State& s, double h,
     // Springs alone: their discrete gradient is F, computed without the midpoint forces whose
     // difference would add round-off (an undamped free cube keeps its momenta to 1e-13).
     f_.setZero(size);
-    springForces(model, s.x.data(), x1.data(), f_.data());
+    addDiscreteGradient(springs_, model.numPoints(), s.x.data(), x1.data(), f_.data());
     work_ = inertia * (x1 - s.x - h * s.v);
     r_ = work_ - f_;
     return work_.norm() + f_.norm();
@@ -176,26 +135,26 @@ double EnergyMomentum::evaluate(const Model& model, const State& s, double h,
   // Every force at the midpoint and its velocity, and at rest: their difference is the
   // dissipation (damping, friction), the second the elastic and external forces.
   model.forces(xm_, vm_, f_);
-  work_.setZero(size);
+  work_.setZero(size);  // a zero velocity until the external forces below
   model.forces(xm_, work_, fRest_);
   // f = f_m - springs(x_m) + springs' discrete gradient: the dissipation f_m - f_rest and the
   // contact and external forces f_rest - springs(x_m) at the midpoint stay.
-  addElasticSpringForces(model, xm_.data(), -1.0, f_.data());
-  springForces(model, s.x.data(), x1.data(), f_.data());
-  // Contact: Gonzalez's correction along the step, where any point touches.
+  fElastic_.setZero(size);
+  model.springs().accumulate(xm_.data(), work_.data(), fElastic_.data());  // at rest: elastic
+  f_ -= fElastic_;
+  addDiscreteGradient(springs_, model.numPoints(), s.x.data(), x1.data(), f_.data());
+  // Contact: Gonzalez's correction along the step dx = h v_m, where any point touches.
   if (contact) {
     // F_c(x_m): the elastic forces at rest less the springs' and the external ones.
-    fSprings_ = fRest_;
-    addElasticSpringForces(model, xm_.data(), -1.0, fSprings_.data());
+    fContact_ = fRest_ - fElastic_;
     model.externalForces(xm_.data(), work_);
-    if (work_.size() == size) fSprings_ -= work_;
-    const Eigen::VectorXd dx = x1 - s.x;
-    const double contact0 = model.potentialEnergy(s.x.data()) - springEnergy(model, s.x.data());
-    const double contact1 = model.potentialEnergy(x1.data()) - springEnergy(model, x1.data());
-    const double dx2 = dx.squaredNorm();
+    if (work_.size() == size) fContact_ -= work_;
+    const double contact0 = model.potentialEnergy(s.x.data()) - model.springs().energy(s.x.data());
+    const double contact1 = model.potentialEnergy(x1.data()) - model.springs().energy(x1.data());
+    const double dx2 = h * h * vm_.squaredNorm();
     if (dx2 > 0.0) {
-      const double alpha = (-(contact1 - contact0) - fSprings_.dot(dx)) / dx2;
-      f_ += alpha * dx;
+      const double alpha = (-(contact1 - contact0) - h * fContact_.dot(vm_)) / dx2;
+      f_ += (alpha * h) * vm_;
     }
   }
   work_ = inertia * (x1 - s.x - h * s.v);
@@ -215,12 +174,13 @@ void EnergyMomentum::assemble(const Model& model, const State& s, double h) {
   // x_m for contact and damping, each spring's midpoint block then replaced by the exact
   // derivative of its discrete gradient F_b = -s d_m, s = k (1 - 2L/(l0 + l1)):
   //   dF_b/dx1_b = -(s/2) I - g d_m u1',  g = 2kL/(l0 + l1)^2,  u1 = d1/l1
-  // (not symmetric: LU). Exact, Newton converges quadratically near the step.
+  // (not symmetric). Exact, Newton converges quadratically near the step. S_ keeps the midpoint's
+  // symmetric matrix (springs clamped), the preconditioner.
   jacobian_->assemble(xm_.data(), {.clampCompression = true});
   jacobian_->combine(0.5 * h, 0.25 * h * h, S_);
   A_ = S_;
   const std::ptrdiff_t n = model.numPoints();
-  const std::vector<Spring> springs = model.springs().springs();
+  const std::vector<Spring>& springs = springs_;
   const std::vector<int>& slots = jacobian_->springSlots();
   const std::vector<int>& diagonal = jacobian_->diagonalSlots();
   double* a = A_.valuePtr();
@@ -300,10 +260,9 @@ StepResult EnergyMomentum::solveNewton(double h, double tolerance) {
   // where BiCGSTAB stalls short of that (seen on the spinning cube at k 1e5 where springs
   // buckle and the clamped preconditioner is far from the exact matrix), the sparse LU.
   if (delta_.allFinite() && bicg.error() <= kKrylovAcceptable) return StepResult::success();
-  if (!lu_) lu_ = std::make_unique<SparseLuFallback>();
-  if (!lu_->analysed) {
+  if (!lu_) {  // the first fallback for this model: its pattern analysed once
+    lu_ = std::make_unique<SparseLuFallback>();
     lu_->lu.analyzePattern(A_);
-    lu_->analysed = true;
   }
   lu_->lu.factorize(A_);
   ++luFallbacks_;
@@ -337,7 +296,6 @@ StepResult EnergyMomentum::solve(const Model& model, const State& s, double h, b
     }
     if (k >= options_.newtonMaxIterations) break;
     if (interruptRequested()) return StepResult::interruption();
-    // A kept factor while the residual falls fast; a new one at x_m where it does not.
     // The exact matrix at every iterate; its preconditioner kept while the residual falls fast.
     assemble(model, s, h);
     if (!factored || !options_.reuseFactor || norm > options_.refactorRatio * previous) {

@@ -60,6 +60,9 @@ class EnergyMomentum final : public Integrator {
 
  private:
   void bind(const Model& model);
+  // The discrete-gradient spring forces of `springs` (n points) added to f.
+  static void addDiscreteGradient(const std::vector<Spring>& springs, std::ptrdiff_t n,
+                                  const double* x0, const double* x1, double* f);
   // r at x1 into r_, and the scale its relative test divides by; from (x0, v0), step h.
   double evaluate(const Model& model, const State& s, double h, const Eigen::VectorXd& x1);
   // One step of h from s, retried as two halves while unconverged; depth halvings so far.
@@ -94,7 +97,8 @@ class EnergyMomentum final : public Integrator {
   std::unique_ptr<SpdSolver> spd_;
   std::unique_ptr<SparseLuFallback> lu_;  // where BiCGSTAB stalls
   long krylovIterations_ = 0, luFallbacks_ = 0;
-  Eigen::VectorXd x1_, trial_, r_, delta_, xm_, vm_, f_, fRest_, fSprings_, work_;
+  std::vector<Spring> springs_;  // the model's, listed once in bind()
+  Eigen::VectorXd x1_, trial_, r_, delta_, xm_, vm_, f_, fRest_, fElastic_, fContact_, work_;
   bool stepUnconverged_ = false;
   bool springDamping_ = false;  // any spring with damping
   bool isolated_ = false;       // the last evaluation had springs alone (no damping)
