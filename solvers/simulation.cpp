@@ -116,9 +116,10 @@ StepResult Simulation::step() {
   if (!verified_) {  // else the last step's divergence check saw it finite
     JELLO_VALIDATE(std::isfinite(state_.x.sum() + state_.v.sum()),
                    "the state handed to a step is finite");
-    // A barrier scene must start outside every solid (callers say so before stepping).
-    if (std::string why = model_.contactError(state_.x.data()); !why.empty()) {
-      return StepResult::failure(why);
+    // A barrier scene must start outside every solid, every start finite (callers say so
+    // before stepping).
+    if (const std::optional<StartProblem> why = model_.startProblem(state_)) {
+      return StepResult::failure(why->message);
     }
     verified_ = true;
   }

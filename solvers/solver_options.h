@@ -66,7 +66,9 @@ struct CvodeOptions {
   // sphere): CVODE stops there and restarts, instead of stepping over the force's kink.
   bool contactRoots = false;
   bool stabilityLimitDetection = true;
-  double maxStep = 0.0;            // s, 0: no limit
+  double maxStep = 0.0;  // s, 0: no limit; else within kMinMaxStep..kMaxMaxStep
+  // CVODE keeps 1/hmax: a subnormal hmax made it infinite and the limit silently vanished.
+  static constexpr double kMinMaxStep = 1e-12, kMaxMaxStep = 1e6;
   long maxStepsPerCall = 1000000;  // internal steps CVODE may take to reach one output time
   LinearSolverKind linearSolver = kDefaultLinearSolver;
   PreconditionerKind preconditioner = kDefaultPreconditioner;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -244,23 +245,79 @@ double Model::contactStepBound(const double* x, const double* dx) const {
   return bound;
 }
 
-std::string Model::contactError(const double* x) const {
-  if (!barrierContact()) return "";
-  for (const auto& o : obstacles_) {
-    if (!o->hasExteriorDistance()) {
-      return "the barrier contact model needs each solid's distance outside it, which the " +
-             std::string(obstacleName(o->kind())) + " does not have yet (use penalty or smooth)";
-    }
-    for (int p = 0; p < n_; ++p) {
-      const double d = o->signedDistance(pointAt(x, n_, p));
-      if (!(d > 0.0)) {
-        return "the barrier contact model needs every point outside every solid, but point " +
-               std::to_string(p) + " is " + (d < 0.0 ? "inside" : "on the surface of") + " the " +
-               std::string(obstacleName(o->kind())) + " (" + std::to_string(-d) + " m deep)";
+namespace {
+
+// The setting a contact problem of this obstacle comes from: the walls are the box's, their
+// stiffness the constants' kCollision; the others are each an extension (the plane a flag).
+std::string settingOf(ObstacleKind kind) {
+  return kind == ObstacleKind::Walls ? "kCollision" : std::string(obstacleName(kind));
+}
+
+std::string joules(double e) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", e);
+  return text;
+}
+
+}  // namespace
+
+std::optional<StartProblem> Model::startProblem(const State& s) const {
+  const double* x = s.x.data();
+  if (barrierContact()) {
+    for (const auto& o : obstacles_) {
+      if (!o->hasExteriorDistance()) {
+        return StartProblem{"contact",
+                            "the barrier contact model needs each solid's distance "
+                            "outside it, which the " +
+                                std::string(obstacleName(o->kind())) +
+                                " does not have yet (use penalty or smooth)"};
+      }
+      for (int p = 0; p < n_; ++p) {
+        const double d = o->signedDistance(pointAt(x, n_, p));
+        if (!(d > 0.0)) {
+          return StartProblem{
+              settingOf(o->kind()),
+              "the barrier contact model needs every point outside every solid, but point " +
+                  std::to_string(p) + " is " + (d < 0.0 ? "inside" : "on the surface of") +
+                  " the " + std::string(obstacleName(o->kind())) + " (" + std::to_string(-d) +
+                  " m deep)"};
+        }
       }
     }
   }
-  return "";
+  const double kinetic = 0.5 * mass_ * s.v.squaredNorm();
+  if (!std::isfinite(kinetic)) {
+    return StartProblem{"velocities", "the start's kinetic energy is " + joules(kinetic) +
+                                          " J: every term of the energy must be finite"};
+  }
+  if (const double e = springs_.energy(x); !std::isfinite(e)) {
+    return StartProblem{"kElastic", "the springs' energy at the start is " + joules(e) +
+                                        " J: every term of the energy must be finite"};
+  }
+  for (const auto& o : obstacles_) {
+    if (const double e = o->energy(x, n_); !std::isfinite(e)) {
+      const std::string name(obstacleName(o->kind()));
+      return StartProblem{settingOf(o->kind()),
+                          "the " + name + "'s contact energy at the start is " + joules(e) +
+                              " J (the cube starts deep inside the " + name +
+                              "): every term of the energy must be finite"};
+    }
+  }
+  return std::nullopt;
+}
+
+WorldFileError startError(const StartProblem& problem, const World& world,
+                          const std::string& file) {
+  if (const SourcePlace* place = world.sourceOf(problem.what)) {
+    return WorldFileError(file, place->line, place->token, problem.message);
+  }
+  return WorldFileError(file, 0, problem.what, problem.message);
+}
+
+void checkStart(const World& world, const std::string& file) {
+  if (const std::optional<StartProblem> problem = Model(world).startProblem(initialState(world))) {
+    throw startError(*problem, world, file);
+  }
 }
 
 double Model::userForceWork(const Eigen::VectorXd& x0, const Eigen::VectorXd& x1) const {

@@ -22,6 +22,7 @@
 #include "src/effects/spring_forces.h"
 #include "src/state.h"
 #include "src/world/world.h"
+#include "src/world/world_reader.h"
 
 namespace jello {
 
@@ -47,6 +48,21 @@ struct Energy {
   double contact = 0.0;  // J, penalty springs of every obstacle
   double total() const { return kinetic + spring + contact; }
 };
+
+// Why a simulation cannot start: the setting to blame, as World::sourceOf names it
+// ("kElastic", "kCollision", "plane", "sphere", "cone", "spiral", "contact", or "velocities"),
+// and what is wrong.
+struct StartProblem {
+  std::string what;
+  std::string message;
+};
+
+// The problem as the reader reports a bad file: the file, and the line and token where the
+// world set `what` (line 0 and the file's name when it did not come from a file).
+WorldFileError startError(const StartProblem& problem, const World& world, const std::string& file);
+// Throws startError when a simulation of `world` (read from `file`) could not start: for
+// programs that load a world and step it later (the viewer).
+void checkStart(const World& world, const std::string& file);
 
 // How often each effect was evaluated: lets tests check that absent effects cost nothing.
 // A snapshot of the model's counters, which are atomic (threads may share a model).
@@ -108,9 +124,11 @@ class Model {
   // The largest s in [0, 1] for which no point moving from x along s dx (3n each) reaches a
   // solid (Obstacle::stepBound): the barrier's line-search bound.
   double contactStepBound(const double* x, const double* dx) const;
-  // Why this model cannot step from positions x, or empty: the barrier needs every solid's
-  // exterior distance and every point outside every solid.
-  std::string contactError(const double* x) const;
+  // Why this model cannot step from state s, or nothing: the barrier needs every solid's
+  // exterior distance and every point outside every solid, and every term of the start's
+  // energy must be finite (a cube deep inside a sphere of radius 1e308 would start with an
+  // infinite contact energy that the implicit methods then ignore).
+  std::optional<StartProblem> startProblem(const State& s) const;
 
   // Work (J) the force field does on the points moving from x0 to x1 (3n each), by the
   // trapezoid rule along the straight path: sum of 1/2 (F(x0) + F(x1)) . (x1 - x0). Exact for

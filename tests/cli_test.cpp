@@ -4,6 +4,7 @@
 #include <sys/sysmacros.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -405,6 +406,48 @@ TEST(JelloSim, RefusesABadWorldNamingFileAndLine) {
   EXPECT_TRUE(contains(r.output, "'x'")) << r.output;
 }
 
+// Issue 41, item 5: a cube that starts deep inside a sphere of radius 1e308 ran to exit 0 under
+// implicit with an infinite contact energy; it is refused before the run, naming the line.
+TEST(JelloSim, RefusesAStartWhoseEnergyIsNotFiniteNamingTheLine) {
+  test::TempDir dir;
+  const std::string jello = test::readFile(test::worldsDir() / "jello.w");
+  const auto deep = dir.path() / "deep.w";
+  std::ofstream(deep) << jello << "sphere 0 0 -1 1e308\n";
+  const std::string line = std::to_string(std::count(jello.begin(), jello.end(), '\n') + 1);
+  for (const char* integrator : {"implicit", "midpoint", "bdf2", "newmark", "rk4"}) {
+    std::string command = sim();
+    command.append(" ").append(deep.string()).append(" --steps 5 --integrator ");
+    command.append(integrator).append(" --out ").append((dir.path() / "out.w").string());
+    const Outcome r = run(command);
+    EXPECT_EQ(r.code, 1) << integrator << ": " << r.output;
+    EXPECT_TRUE(contains(r.output, deep.string() + ":" + line +
+                                       ": the sphere's contact energy at the start is inf J"))
+        << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / "out.w"));
+  }
+}
+
+// Issue 41 (low): a force field of resolution 1024 read from a pipe (its size unknown) allocated
+// about 25 GB before reading a number. Under a 2 GB address-space limit the truncated field is
+// now refused naming file and line, not reported as out of memory.
+TEST(JelloSim, AHugeFieldFromAPipeIsReadAsItArrives) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer reserves more address space than the limit allows";
+#else
+  test::TempDir dir;
+  const auto head = dir.path() / "head.w";
+  std::ofstream(head) << "RK4\n0.001 1\n1 0 1 0\n0.001953125\n0\n1024\n1 2 3\n4 5 6\n";
+  std::string command = "bash -c 'ulimit -v 2000000; cat ";
+  command.append(head.string()).append(" | ").append(sim());
+  command.append(" /dev/stdin --max-field-resolution 1024 --steps 1'");
+  const Outcome r = run(command);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_TRUE(contains(r.output, "/dev/stdin:")) << r.output;
+  EXPECT_TRUE(contains(r.output, "force-field")) << r.output;
+  EXPECT_FALSE(contains(r.output, "memory")) << r.output;
+#endif
+}
+
 TEST(JelloSim, AnswersBadUsageWithExitCodeTwo) {
   EXPECT_EQ(run(sim()).code, 2);
   EXPECT_EQ(run(sim() + " " + world("jello.w") + " --integrator verlet").code, 2);
@@ -555,7 +598,7 @@ TEST(Contact, FlagsChooseTheModelInBothToolsAndBadOnesAreRefused) {
   const Outcome spiral =
       run(sim() + " " + world("showcase.w") + " --steps 1 --contact barrier --quiet");
   EXPECT_EQ(spiral.code, 1);
-  EXPECT_TRUE(contains(spiral.output, "showcase.w: the barrier contact model needs"))
+  EXPECT_TRUE(contains(spiral.output, "showcase.w:3: the barrier contact model needs"))
       << spiral.output;
 }
 
@@ -725,6 +768,34 @@ TEST(Experiments, StabilityRefusesTimesAndStepsItCannotRun) {
     EXPECT_EQ(r.code, 2) << bad << "\n" << r.output;
     EXPECT_TRUE(contains(r.output, "must be at")) << bad << "\n" << r.output;
   }
+}
+
+// Issue 41 (low): `--name ../escape` or an absolute --name wrote outside --out-dir, `--name ''`
+// wrote hidden files (".csv"); cvode's --max-step 4.9e-324 was silently no limit.
+TEST(Experiments, NameIsAStemInTheOutputDirectoryAndMaxStepIsNotSubnormal) {
+  const std::filesystem::path bin = std::filesystem::path(sim()).parent_path();
+  if (!std::filesystem::exists(bin / "jello-stability")) GTEST_SKIP() << "not built here";
+  test::TempDir dir;
+  const auto out = dir.path() / "out";
+  for (const char* bad :
+       {"--name ../escape", "--name /tmp/jello-escape", "--name ''", "--name .hidden"}) {
+    const Outcome r = run((bin / "jello-stability").string() + " --quick --quiet " + bad +
+                          " --out-dir " + out.string() + " 2>&1");
+    EXPECT_EQ(r.code, 2) << bad << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, "--name")) << bad << "\n" << r.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "escape.csv"));
+  EXPECT_FALSE(std::filesystem::exists("/tmp/jello-escape.csv"));
+  for (const char* bad : {"4.9e-324", "1e-300", "1e300"}) {
+    const Outcome r = run(sim() + " " + world("jello.w") +
+                          " --integrator cvode --steps 1 --quiet --max-step " + bad);
+    EXPECT_EQ(r.code, 2) << bad << "\n" << r.output;
+  }
+  EXPECT_EQ(run(sim() + " " + world("jello.w") +
+                " --integrator cvode --steps 1 --quiet "
+                "--max-step 1e-4")
+                .code,
+            0);
 }
 
 // Every numeric option of every program refuses NaN and infinities with exit code 2, found

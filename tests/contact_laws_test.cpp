@@ -427,23 +427,76 @@ TEST(BarrierContact, WorldsWithASpiralOrAPointInsideAreRefusedAndTheExtensionRou
   EXPECT_NE(test::readFile(dir.path() / "b.w").find("\ncontact barrier 0.002 350\n"),
             std::string::npos);
   const Model fine(w);
-  EXPECT_EQ(fine.contactError(initialState(w).x.data()), "");
+  EXPECT_FALSE(fine.startProblem(initialState(w)).has_value());
 
   World spiral = w;
   spiral.spiral = Spiral{0.1, -0.2, 1.0, 0.4, 1.6, 1.2, 1.5, 0.3};
   spiral.plane.reset();
-  const std::string why = Model(spiral).contactError(initialState(spiral).x.data());
+  const std::string why = Model(spiral).startProblem(initialState(spiral)).value().message;
   EXPECT_NE(why.find("spiral does not have yet"), std::string::npos) << why;
 
   World inside = w;
   inside.sphere = Sphere{{0.5, 0.5, 0.5}, 0.3};  // around the cube's centre
-  const std::string in = Model(inside).contactError(initialState(inside).x.data());
+  const std::string in = Model(inside).startProblem(initialState(inside)).value().message;
   EXPECT_NE(in.find("is inside the sphere"), std::string::npos) << in;
   // Simulation refuses to step it rather than compute infinite forces.
   Simulation sim(inside);
   const StepResult r = sim.step();
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.message.find("inside the sphere"), std::string::npos) << r.message;
+}
+
+// A start no step can begin from (issue 41, item 5): a cube deep inside a sphere of radius
+// 1e308, or under a plane 1e300 m off, has an infinite contact energy; implicit, midpoint, bdf2
+// and newmark simulated it as if the solid were not there. It is refused on load, naming the
+// line that set the solid, and no integrator steps it.
+TEST(StartCheck, AStartWhoseEnergyIsNotFiniteIsRefusedNamingTheLine) {
+  test::TempDir dir;
+  const std::string jello = test::readFile(std::filesystem::path(JELLO_WORLDS_DIR) / "jello.w");
+  const auto lineCount = [](const std::string& text) {
+    return static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+  };
+  {
+    const std::filesystem::path path = dir.path() / "deep.w";
+    std::ofstream(path) << jello << "sphere 0 0 -1 1e308\n";
+    const World w = readWorld(path);
+    try {
+      checkStart(w, path.string());
+      ADD_FAILURE() << "a cube inside a sphere of radius 1e308 was accepted";
+    } catch (const WorldFileError& e) {
+      EXPECT_EQ(e.line(), lineCount(jello) + 1) << e.what();
+      EXPECT_EQ(e.token(), "sphere");
+      EXPECT_NE(std::string(e.what()).find("sphere's contact energy at the start is inf"),
+                std::string::npos)
+          << e.what();
+    }
+    for (IntegratorKind kind : allIntegrators()) {
+      Simulation sim(w, kind);
+      const StepResult r = sim.step();
+      EXPECT_FALSE(r.ok) << integratorName(kind);
+      EXPECT_NE(r.message.find("every term of the energy must be finite"), std::string::npos)
+          << integratorName(kind) << ": " << r.message;
+    }
+  }
+  {
+    World w = test::loadWorld("jello.w");
+    w.plane = Plane{0.0, 0.0, 1.0, -1e300};  // free only above z = 1e300
+    const std::filesystem::path path = dir.path() / "under.w";
+    writeWorld(w, path);
+    const World back = readWorld(path);
+    const std::optional<StartProblem> problem = Model(back).startProblem(initialState(back));
+    ASSERT_TRUE(problem.has_value());
+    EXPECT_EQ(problem->what, "plane");
+    const WorldFileError e = startError(*problem, back, path.string());
+    ASSERT_NE(back.sourceOf("plane"), nullptr);
+    EXPECT_EQ(e.line(), back.sourceOf("plane")->line);
+    EXPECT_GT(e.line(), 3);
+  }
+  // Every reference world starts finite.
+  for (const char* name : {"jello.w", "showcase.w", "sphere-drop.w", "stiff-k1e4.w"}) {
+    const World w = test::loadWorld(name);
+    EXPECT_FALSE(Model(w).startProblem(initialState(w)).has_value()) << name;
+  }
 }
 
 }  // namespace

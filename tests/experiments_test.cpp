@@ -4,12 +4,14 @@
 #include <Spectra/MatOp/SparseSymMatProd.h>
 #include <Spectra/SymEigsSolver.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <numbers>
@@ -17,6 +19,7 @@
 #include <sstream>
 #include <thread>
 
+#include "experiments/common/json_finite.h"
 #include "experiments/studies/atlas.h"
 #include "experiments/studies/csv_table.h"
 #include "experiments/studies/parallel_for.h"
@@ -32,6 +35,29 @@
 
 namespace jello::experiments {
 namespace {
+
+// Issue 41, item 5: JSON has no infinity, so nlohmann writes null; what the programs write says
+// why (the contact energy of an infinite start was a bare null in jello-sim's statistics).
+TEST(Outputs, ANullInTheStatisticsSaysWhy) {
+  nlohmann::json doc = {
+      {"energy_end", {{"contact", std::numeric_limits<double>::infinity()}, {"spring", 1.5}}},
+      {"residuals", {0.5, std::nan("")}},
+      {"min_obstacle_distance_m", nullptr},
+      {"null_because", {{"min_obstacle_distance_m", "the scene has no solid"}}}};
+  explainNonFinite(doc);
+  EXPECT_TRUE(doc["energy_end"]["contact"].is_null());
+  EXPECT_EQ(doc["energy_end"]["spring"], 1.5);
+  EXPECT_TRUE(doc["residuals"][1].is_null());
+  EXPECT_EQ(doc["null_because"]["energy_end.contact"], "not finite: inf");
+  EXPECT_EQ(doc["null_because"]["residuals[1]"], "not finite: nan");
+  EXPECT_EQ(doc["null_because"]["min_obstacle_distance_m"], "the scene has no solid");
+  // Every null in the document has its reason.
+  const auto parsed = nlohmann::json::parse(doc.dump());
+  EXPECT_EQ(parsed["null_because"].size(), 3u);
+  nlohmann::json finite = {{"a", 1.0}};
+  explainNonFinite(finite);
+  EXPECT_FALSE(finite.contains("null_because"));
+}
 
 TEST(StabilityAnalysis, WMaxOfTheLatticeAtRestIsTheDenseSolvesValue) {
   // src/PHYSICS.md: w_max = 4.0715 sqrt(k/m) for the full 8^3 lattice at rest.
@@ -493,6 +519,69 @@ TEST(MpiUsage, ABadArgumentIsReportedOnceAndFailsTheJob) {
     ++count;
   }
   EXPECT_EQ(count, 1u) << o.output;
+}
+
+// Issue 41, item 3: a bad option on one rank left the good rank at 100% CPU for minutes, its
+// partner silent in MPI_Finalize; ranks given different values wrote a CSV whose rows
+// alternated between them. Rank 0's command line is the job's: any other fails it at once.
+TEST(MpiUsage, RanksGivenDifferentArgumentsFailTheJobAtOnceWithOneMessage) {
+  test::TempDir dir;
+  const std::string stability =
+      std::string(JELLO_STABILITY) + " --quick --quiet --out-dir " + (dir.path() / "o").string();
+  for (const char* other : {" --bogus", " --time nan", " --k 100000"}) {
+    const auto started = std::chrono::steady_clock::now();
+    const test::Outcome o = test::run(
+        "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 timeout 100 " JELLO_MPIEXEC
+        " --oversubscribe -np 1 " +
+        stability + " --k 100 : -np 1 " + stability + other);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    EXPECT_NE(o.code, 0) << other << ": " << o.output;
+    EXPECT_NE(o.code, 124) << other << ": the job hung";
+    EXPECT_LT(seconds, 30.0) << other;
+    const std::string message = "rank 1 was started with other arguments than rank 0";
+    const std::size_t at = o.output.find(message);
+    EXPECT_NE(at, std::string::npos) << other << ": " << o.output;
+    EXPECT_EQ(o.output.find(message, at + 1), std::string::npos) << "said once: " << o.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / "o" / "stability.csv"));
+  }
+}
+
+// Issue 41, item 2: the README's mpirun failed in MPI_Init on these machines from a shell with
+// nothing exported (the programs started themselves again to set the solver threads' variables).
+// Its command as written (four ranks of jello-stability, --quick into a scratch directory;
+// as root, --allow-run-as-root), with no thread variable and no PMIx setting in the environment:
+// it runs, and the sidecar shows the settings were made by the libraries' calls, not exported.
+TEST(MpiUsage, TheReadmesCommandRunsFromAShellWithNothingExported) {
+  std::ifstream readme(std::filesystem::path(JELLO_WORLDS_DIR).parent_path() / "experiments" /
+                       "README.md");
+  std::string command;
+  for (std::string line; std::getline(readme, line);) {
+    if (line.rfind("mpirun ", 0) == 0) {
+      command = line.substr(0, line.find('#'));
+      break;
+    }
+  }
+  ASSERT_FALSE(command.empty()) << "experiments/README.md has no mpirun command";
+  test::TempDir dir;
+  const auto replace = [&](const std::string& what, const std::string& with) {
+    const std::size_t at = command.find(what);
+    ASSERT_NE(at, std::string::npos) << what << " in " << command;
+    command.replace(at, what.size(), with);
+  };
+  replace("build/release/bin/jello-stability", JELLO_STABILITY);
+  replace("experiments/results", dir.path().string() + " --quick --quiet");
+  if (::geteuid() == 0) replace("mpirun ", "mpirun --allow-run-as-root ");
+  const test::Outcome o = test::run(
+      "env -u OMP_THREAD_LIMIT -u OPENBLAS_NUM_THREADS -u OMP_WAIT_POLICY -u OMP_NUM_THREADS "
+      "-u PMIX_MCA_gds -u OMPI_ALLOW_RUN_AS_ROOT -u OMPI_ALLOW_RUN_AS_ROOT_CONFIRM timeout 300 " +
+      command);
+  ASSERT_EQ(o.code, 0) << command << "\n" << o.output;
+  std::ifstream in(dir.path() / "stability.json");
+  const nlohmann::json sidecar = nlohmann::json::parse(in);
+  EXPECT_EQ(sidecar.at("mpi_ranks"), 4);
+  EXPECT_EQ(sidecar.at("OPENBLAS_NUM_THREADS"), "");  // not exported, and no restart set it
+  EXPECT_EQ(sidecar.at("solver_threads"), "openblas 1 thread; openmp serial");
 }
 #endif
 

@@ -7,9 +7,12 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <vector>
 
 #include "solvers/linalg/dense_tail.h"
+#include "solvers/linalg/linear_solver.h"
 #include "src/model.h"
 #include "src/world/scene_builder.h"
 #include "tests/test_support.h"
@@ -155,6 +158,16 @@ TEST_P(PrefactoredCholeskyBothWays, UpdatesAndDowndatesTheDiagonal) {
 // The dense tail (solvers/linalg/dense_tail.h) on its own: a lower triangle of 21 columns (two
 // whole panels and a padded one) solves L y = b and L' y = b like Eigen's triangular solves, one to
 // three right-hand sides at once.
+// Issue 41 (low): a failed solve said "relative residual -nan".
+TEST(LinearSolverMessages, AResidualIsDescribedOrWhyItCannotBe) {
+  EXPECT_EQ(describeResidual(1e-3, 10.0), "relative residual 0.0001");
+  EXPECT_EQ(describeResidual(std::nan(""), 1.0),
+            "the residual is not finite: the solution holds NaN or infinity");
+  EXPECT_EQ(describeResidual(2.0, 0.0), "residual 2 against a right-hand side of norm 0");
+  EXPECT_EQ(describeResidual(std::numeric_limits<double>::infinity(), 0.0).find("nan"),
+            std::string::npos);
+}
+
 TEST(DenseTail, SolvesBothTrianglesLikeEigen) {
   const int w = 21;
   Eigen::MatrixXd L = Eigen::MatrixXd::Random(w, w).triangularView<Eigen::StrictlyLower>();

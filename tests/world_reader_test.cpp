@@ -284,6 +284,9 @@ TEST(WorldReader, ReportsAMissingFile) {
     EXPECT_EQ(e.line(), 0);
     EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/world.w"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("cannot open"), std::string::npos);
+    // The file as a whole has no line: no "world.w:0:" (issue 41, low).
+    EXPECT_EQ(std::string(e.what()).rfind("/nonexistent/dir/world.w: cannot open", 0), 0u)
+        << e.what();
   }
 }
 

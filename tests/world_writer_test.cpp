@@ -3,8 +3,10 @@
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -12,6 +14,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstring>
+#include <fstream>
 #include <limits>
 #include <random>
 #include <string>
@@ -196,6 +199,56 @@ TEST(AtomicFile, WritesIntoAFifoWithoutReplacingIt) {
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()),
                           std::filesystem::directory_iterator{}),
             1);
+}
+
+// Issue 41 (low): a FIFO with no process at its other end blocked forever, as an output (--stats,
+// stability.json, a viewer frame) and as a world; a socket as an output was refused only after
+// the run. Each is now refused, the FIFOs after a wait, and a writer that comes is read whole.
+TEST(AtomicFile, AFifoWithNobodyAtItsOtherEndIsRefusedAfterAWaitAndASocketAtOnce) {
+  test::TempDir dir;
+  const auto fifo = dir.path() / "fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0) << std::strerror(errno);
+  jello::testing::fifoWaitSeconds = 0.3;
+  struct Restore {
+    ~Restore() { jello::testing::fifoWaitSeconds = kFifoWaitSeconds; }
+  } restore;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    writeFileAtomically(fifo, "nobody reads this");
+    ADD_FAILURE() << "wrote into a FIFO nobody reads";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("a FIFO that no process reads (waited 0.3 s)"),
+              std::string::npos)
+        << e.what();
+  }
+  try {
+    (void)readWorld(fifo);
+    ADD_FAILURE() << "read a world from a FIFO nobody writes";
+  } catch (const WorldFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("a FIFO that no process writes"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 5.0);
+  EXPECT_TRUE(std::filesystem::is_fifo(fifo));
+
+  jello::testing::fifoWaitSeconds = 5.0;
+  const World sent = test::loadWorld("jello.w");
+  std::thread writer([&] { std::ofstream(fifo) << formatWorld(sent); });
+  const World got = readWorld(fifo);
+  writer.join();
+  EXPECT_EQ(got.positions.size(), sent.positions.size());
+  EXPECT_EQ(got.kElastic, sent.kElastic);
+
+  const auto socketPath = dir.path() / "sock";
+  const int s = ::socket(AF_UNIX, SOCK_STREAM, 0);
+  ASSERT_GE(s, 0);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  std::strncpy(address.sun_path, socketPath.c_str(), sizeof address.sun_path - 1);
+  ASSERT_EQ(::bind(s, reinterpret_cast<const sockaddr*>(&address), sizeof address), 0)
+      << std::strerror(errno);
+  EXPECT_NE(outputProblem(socketPath).find("it is a socket"), std::string::npos);
+  ::close(s);
 }
 
 TEST(AtomicFile, WritesIntoAPipeNamedLikeDevStdout) {

@@ -53,6 +53,13 @@ void writeJpeg(const std::filesystem::path& path, const Image& image, int qualit
 }
 
 Image readImage(const std::filesystem::path& path) {
+  // Read twice (its size, then its pixels): a FIFO would block forever or lose its start.
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(path, error)) {
+    throw std::runtime_error(
+        path.string() + ": cannot read image: " +
+        (std::filesystem::exists(path, error) ? "not a regular file" : "no such file"));
+  }
   int width = 0, height = 0, channels = 0;
   // Refused before decoding: a huge image would allocate gigabytes.
   if (stbi_info(path.c_str(), &width, &height, &channels) && (width > 16384 || height > 16384)) {

@@ -14,6 +14,7 @@
 #include "src/base/finite_options.h"
 #include "src/base/out_of_memory.h"
 #include "src/base/parallel.h"
+#include "src/model.h"
 #include "src/world/world_reader.h"
 #include "viewer/texture.h"
 #include "viewer/viewer_app.h"
@@ -142,7 +143,7 @@ std::string apply(const Args& args, jello::viewer::ViewerOptions& opt) {
 
 int main(int argc, char** argv) {
   jello::exitCleanlyWhenOutOfMemory("jello");
-  jello::applySolverThreadSettings(argv);
+  jello::applySolverThreadSettings();
   jello::leaveOneCpuFree();  // the drawing thread's (src/base/parallel.h)
   jello::viewer::ViewerOptions opt;
   Args args;
@@ -169,6 +170,7 @@ int main(int argc, char** argv) {
   jello::World loaded;
   try {
     loaded = jello::readWorld(opt.source.world, opt.source.limits);
+    jello::checkStart(loaded, opt.source.world.string());
   } catch (const std::exception& e) {
     return usageError(e.what());
   }

@@ -1,5 +1,6 @@
 #include "viewer/viewer_session.h"
 
+#include "src/model.h"
 #include "src/world/world_writer.h"
 #include "viewer/viewer_state.h"
 
@@ -38,6 +39,7 @@ std::optional<std::string> ViewerSession::reload() {
   World world;
   try {
     world = readWorld(source_.world, source_.limits);
+    checkStart(world, source_.world.string());
   } catch (const std::exception& e) {
     return std::string(e.what());
   }

@@ -133,11 +133,13 @@ void registerImplicitStepBenchmarks();
 
 int main(int argc, char** argv) {
   // Single-threaded BLAS and CHOLMOD (see solvers/linalg/solver_threads.h).
-  jello::applySolverThreadSettings(argv);
+  jello::applySolverThreadSettings();
   benchmark::AddCustomContext("blas", jello::loadedBlas());
-  benchmark::AddCustomContext("OPENBLAS_NUM_THREADS", std::getenv("OPENBLAS_NUM_THREADS"));
-  benchmark::AddCustomContext("OMP_THREAD_LIMIT", std::getenv("OMP_THREAD_LIMIT"));
-  benchmark::AddCustomContext("OMP_WAIT_POLICY", std::getenv("OMP_WAIT_POLICY"));
+  benchmark::AddCustomContext("solver_threads", jello::solverThreadSettings());
+  for (const char* name : {"OPENBLAS_NUM_THREADS", "OMP_THREAD_LIMIT", "OMP_WAIT_POLICY"}) {
+    const char* value = std::getenv(name);
+    benchmark::AddCustomContext(name, value ? value : "");
+  }
   registerStepBenchmarks();
   registerImplicitStepBenchmarks();
   benchmark::Initialize(&argc, argv);

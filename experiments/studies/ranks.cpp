@@ -105,6 +105,23 @@ bool Ranks::all(bool ok) const {
 #endif
 }
 
+int Ranks::firstDiffering(const std::string& text) const {
+  if (!distributed()) return -1;
+#ifdef JELLO_HAVE_MPI
+  // A command line is far below 2 GB: an int counts its bytes.
+  int length = int(text.size());
+  check(MPI_Bcast(&length, 1, MPI_INT, 0, MPI_COMM_WORLD), "MPI_Bcast");
+  std::string rootText = root() ? text : std::string(std::size_t(length), '\0');
+  check(MPI_Bcast(rootText.data(), length, MPI_CHAR, 0, MPI_COMM_WORLD), "MPI_Bcast");
+  int mine = rootText == text ? size_ : rank_, first = size_;
+  check(MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD), "MPI_Allreduce");
+  return first == size_ ? -1 : first;
+#else
+  (void)text;
+  return -1;
+#endif
+}
+
 void Ranks::gather(CsvTable& table) const {
   if (!distributed()) return;
 #ifdef JELLO_HAVE_MPI

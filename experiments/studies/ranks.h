@@ -35,6 +35,10 @@ class Ranks {
   // True on every rank when `ok` is true on every rank (a collective call: all ranks must make
   // it, so that one rank's failure cannot leave the others waiting).
   bool all(bool ok) const;
+  // The lowest rank whose `text` differs from rank 0's, or -1 when all agree (a collective
+  // call). The studies compare their command lines before parsing them: every rank then parses
+  // the same line and refuses it, or not, alike, and no rank waits for one that left.
+  int firstDiffering(const std::string& text) const;
   // Moves every rank's rows of `table` into rank 0's (a collective call); the rows keep their
   // task order (csv_table.h), so rank 0 writes what a single process would.
   void gather(CsvTable& table) const;

@@ -111,6 +111,12 @@ std::optional<StoredTrajectory> readTrajectory(const std::filesystem::path& file
     if (error) throw std::runtime_error(file.string() + ": " + error.message());
     return std::nullopt;
   }
+  // A FIFO (or device) in its place would block the read, or never end: a reference is a file.
+  if (!std::filesystem::is_regular_file(file, error)) {
+    throw std::runtime_error(file.string() +
+                             ": not a regular file (a reference trajectory is "
+                             "one that jello-scaling wrote)");
+  }
   Lines lines(file);
   lines.expect(2, "scene");
   if (lines.token(1) != key.scene) {

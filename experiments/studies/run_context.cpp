@@ -12,6 +12,7 @@
 #include <fstream>
 #include <thread>
 
+#include "experiments/common/json_finite.h"
 #include "solvers/linalg/solver_threads.h"
 #include "src/base/atomic_file.h"
 #include "src/model.h"
@@ -88,6 +89,7 @@ nlohmann::json runContext(int argc, char** argv) {
       {"compiler", std::string(__VERSION__)},
       {"build_type", JELLO_BUILD_TYPE},
       {"blas", jello::loadedBlas()},
+      {"solver_threads", jello::solverThreadSettings()},
       {"OPENBLAS_NUM_THREADS",
        std::getenv("OPENBLAS_NUM_THREADS") ? std::getenv("OPENBLAS_NUM_THREADS") : ""},
       {"OMP_THREAD_LIMIT", std::getenv("OMP_THREAD_LIMIT") ? std::getenv("OMP_THREAD_LIMIT") : ""},
@@ -101,7 +103,9 @@ nlohmann::json runContext(int argc, char** argv) {
 }
 
 void writeSidecar(const std::filesystem::path& path, const nlohmann::json& sidecar) {
-  writeFileAtomically(path, sidecar.dump(2) + "\n");
+  nlohmann::json explained = sidecar;
+  explainNonFinite(explained);
+  writeFileAtomically(path, explained.dump(2) + "\n");
 }
 
 bool prepareOutputDirectory(const std::string& program, const std::filesystem::path& dir,

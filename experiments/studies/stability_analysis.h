@@ -65,7 +65,12 @@ inline constexpr long kBlowUpEnvelopeSteps = 64;
 // methods at least `minSteps` steps: just past its limit an unstable mode grows by a factor
 // barely above 1 per step, which a 0.2 s window of 20 steps (RK4 at k = 10) cannot see.
 struct BlowUpRule {
-  double time = 0.2;  // s
+  // The simulated times and largest steps a study can run: every run's step count (time / dt
+  // with dt down to kMinDtMax) fits, and no step is subnormal (jello-stability's --time and
+  // --dt-max, the Python stability_threshold's time and dt_max).
+  static constexpr double kMinTime = 1e-4, kMaxTime = 1e3;    // s
+  static constexpr double kMinDtMax = 1e-9, kMaxDtMax = 1.0;  // s
+  double time = 0.2;                                          // s
   double energyFactor = 10.0;
   long minSteps = 2000;  // explicit methods (euler, symplectic, rk4) only
 };

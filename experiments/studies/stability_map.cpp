@@ -58,7 +58,7 @@ void addOptions(CLI::App& app, Options& opt) {
   // Bounded so that every run's step count fits (time / dt with dt down to 1e-9 s; 1e308
   // overflowed it and only --min-steps ran, reported as thresholds).
   app.add_option("--time", opt.rule.time, "Simulated time a stable run must survive, s")
-      ->check(jello::cli::range(1e-4, 1e3))
+      ->check(jello::cli::range(BlowUpRule::kMinTime, BlowUpRule::kMaxTime))
       ->capture_default_str();
   app.add_option("--min-steps", opt.rule.minSteps,
                  "Explicit methods run at least this many steps (slow growth shows)")
@@ -74,7 +74,7 @@ void addOptions(CLI::App& app, Options& opt) {
       ->capture_default_str();
   // Not subnormal (4.9e-324 was reported stable to that step).
   app.add_option("--dt-max", opt.dtMax, "Largest time step tried, s")
-      ->check(jello::cli::range(1e-9, 1.0))
+      ->check(jello::cli::range(BlowUpRule::kMinDtMax, BlowUpRule::kMaxDtMax))
       ->capture_default_str();
   app.add_option("--rtol", opt.rtol, "cvode's relative tolerance")
       ->check(jello::cli::positive())

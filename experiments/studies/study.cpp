@@ -20,7 +20,7 @@ Study::Study(std::string program, const std::string& description, std::string de
       app_(program_ + ": " + description) {
   exitCleanlyWhenOutOfMemory(program_.c_str());
   ignoreBrokenPipes(program_.c_str());
-  applySolverThreadSettings(argv);
+  applySolverThreadSettings();
   jobs = ranks_.defaultJobs();
 }
 
@@ -28,13 +28,40 @@ void Study::addCommonOptions(const std::string& quickHelp, const std::string& jo
   app_.add_option("--jobs", jobs, jobsHelp)->check(cli::range(1, 256))->capture_default_str();
   app_.add_option("--out-dir", outDir, "Directory for NAME.csv and NAME.json")
       ->capture_default_str();
-  app_.add_option("--name", name, "File name stem")->capture_default_str();
+  // A stem, not a path: "../x" or "/tmp/x" wrote outside --out-dir, "" hidden files (".csv").
+  app_.add_option("--name", name, "File name stem (in --out-dir: no '/', not starting with '.')")
+      ->check(CLI::Validator(
+          [](const std::string& stem) -> std::string {
+            if (stem.empty()) return "--name must not be empty";
+            if (stem.find('/') != std::string::npos || stem.front() == '.') {
+              return "--name is a file name stem in --out-dir: no '/', not starting with '.'";
+            }
+            for (const char c : stem) {
+              if (static_cast<unsigned char>(c) < 0x20) return "--name holds a control character";
+            }
+            return "";
+          },
+          "STEM"))
+      ->capture_default_str();
   app_.add_flag("--quick", quick, quickHelp);
   app_.add_flag("--quiet", quiet, "No progress line");
 }
 
 std::optional<int> Study::start(int argc, char** argv, const std::function<std::string()>& check) {
   if (!ranks_.error().empty()) return fail(ranks_.error());
+  // Under mpirun every rank parses its own command line: one given another (a bad option, --k
+  // 100 against --k 1e5) would refuse alone and leave the others waiting for it, or run a CSV
+  // whose rows alternate between the two. Rank 0's line is the job's: any other fails it.
+  std::string line;
+  for (int i = 1; i < argc; ++i) line.append(argv[i]).push_back('\0');
+  if (const int other = ranks_.firstDiffering(line); other >= 0) {
+    if (ranks_.root()) {
+      std::cerr << program_ << ": error: rank " << other
+                << " was started with other arguments than rank 0 (every rank of a job runs "
+                   "one study: give them all the same command line)\n";
+    }
+    return 2;
+  }
   try {
     app_.parse(argc, argv);
     refuseNonFiniteNumbers(app_);

@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "experiments/common/json_finite.h"
 #include "experiments/common/modes.h"
 #include "experiments/common/progress.h"
 #include "experiments/common/signal_handler.h"
@@ -215,6 +216,8 @@ void stepAll(Simulation& sim, const Options& opt, Trace& trace, Outcome& o) {
 
 // On standard error: `count` steps were accepted unconverged, and what to do about it.
 void warnUnconverged(const Options& opt, const Simulation& sim, double count) {
+  // An unconverged step that then diverged is not in sim.steps(): "1 of 0 steps" said so.
+  const long taken = std::max(sim.steps(), static_cast<long>(count));
   if (sim.integratorKind() == jello::IntegratorKind::ImplicitLinear) {
     // Its Newton runs only where contact begins, to a cap of its own: the Newton options do
     // nothing for it.
@@ -224,7 +227,7 @@ void warnUnconverged(const Options& opt, const Simulation& sim, double count) {
                  "then keeps its step (--strict makes this an error; the converged method: "
                  "--integrator implicit; a contact whose force has no jump: --contact smooth; "
                  "solvers/README.md, \"implicit-linear\")\n",
-                 count, sim.steps(), opt.solver.implicit.contactNewtonIterations,
+                 count, taken, opt.solver.implicit.contactNewtonIterations,
                  opt.solver.implicit.contactNewtonTolerance);
     return;
   }
@@ -237,7 +240,7 @@ void warnUnconverged(const Options& opt, const Simulation& sim, double count) {
                "--newton-halvings; --strict makes this an error; where a point meets a wall "
                "at speed the penalty's damping force jumps and the step's equations may have "
                "no root: --contact smooth; solvers/README.md, \"implicit\")\n",
-               count, sim.steps(), opt.solver.implicit.newtonMaxIterations, retried.c_str());
+               count, taken, opt.solver.implicit.newtonMaxIterations, retried.c_str());
 }
 
 // The summary as JSON (--stats), and on stderr what went wrong: unconverged steps, a signal, a
@@ -276,6 +279,7 @@ nlohmann::json statistics(const Options& opt, const Simulation& sim, const Outco
     stats["min_obstacle_distance_m"] = *d;
   } else {
     stats["min_obstacle_distance_m"] = nullptr;
+    stats["null_because"]["min_obstacle_distance_m"] = "the scene has no solid";
   }
   for (const jello::Statistic& st : sim.integrator().statistics()) {
     stats["solver"][st.name] = st.value;
@@ -300,6 +304,7 @@ nlohmann::json statistics(const Options& opt, const Simulation& sim, const Outco
     stats["divergence"] = {{"time_s", d.time}, {"step", d.step}, {"reason", d.reason}};
     std::fprintf(stderr, "jello-sim: %s\n", d.describe().c_str());
   }
+  jello::explainNonFinite(stats);
   return stats;
 }
 
@@ -394,8 +399,9 @@ int run(const Options& opt) {
   }
   const double kElastic = world->kElastic, dElastic = world->dElastic;
   Simulation sim(std::move(*world), kind, opt.dt, opt.solver);
-  if (std::string error = sim.model().contactError(sim.state().x.data()); !error.empty()) {
-    std::fprintf(stderr, "jello-sim: error: %s: %s\n", opt.world.c_str(), error.c_str());
+  if (const std::optional<jello::StartProblem> why = sim.model().startProblem(sim.state())) {
+    std::fprintf(stderr, "jello-sim: error: %s\n",
+                 jello::startError(*why, sim.world(), opt.world).what());
     return kExitInput;
   }
   sim.trackObstacleDistance();
@@ -488,7 +494,7 @@ std::optional<int> parseCommandLine(int argc, char** argv, Options& opt) {
 int main(int argc, char** argv) {
   jello::exitCleanlyWhenOutOfMemory("jello-sim");
   jello::ignoreBrokenPipes("jello-sim");
-  jello::applySolverThreadSettings(argv);
+  jello::applySolverThreadSettings();
   // A file-size limit (or a quota) must fail the write, which is reported and cleaned up, not
   // kill the process with a temporary file left behind.
   jello::setSignalHandler("jello-sim", SIGXFSZ, SIG_IGN);

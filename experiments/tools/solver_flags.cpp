@@ -145,7 +145,7 @@ void addSolverFlags(CLI::App& app, SolverFlags& f) {
   option("--max-order", cvode.maxOrder, cvodeOnly + "largest BDF order")->check(cli::range(1, 5));
   flag("--no-stab-lim-det", f.noStabLimDet, cvodeOnly + "switch off BDF stability-limit detection");
   bare("--max-step", cvode.maxStep, cvodeOnly + "largest internal step, s (default none)")
-      ->check(cli::positive());
+      ->check(cli::range(CvodeOptions::kMinMaxStep, CvodeOptions::kMaxMaxStep));
 }
 
 SolverOptions solverOptions(const SolverFlags& f) {

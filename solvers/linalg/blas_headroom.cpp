@@ -33,11 +33,12 @@ std::string blasHeadroomProblem() {
   const double used = mappedBytes();
   const double free = (static_cast<double>(limit.rlim_cur) - used) / mib;
   if (used >= 0.0 && free < kBlasHeadroomMiB) {
-    char buf[400];
+    char buf[480];
     std::snprintf(buf, sizeof buf,
                   "the address-space limit (ulimit -v %.0f kB) leaves %.0f MiB free; CHOLMOD's "
                   "BLAS (OpenBLAS) needs about %.0f MiB at once and would hang retrying: raise "
-                  "the limit or use --linear-solver cg",
+                  "the limit, or solve by conjugate gradients where the program offers them "
+                  "(jello-sim --linear-solver cg; jello-scaling has no such choice)",
                   static_cast<double>(limit.rlim_cur) / 1024.0, free < 0.0 ? 0.0 : free,
                   kBlasHeadroomMiB);
     return buf;

@@ -24,6 +24,18 @@ constexpr double kResidualTolerance = 1e-8;
 
 }  // namespace
 
+std::string describeResidual(double residual, double scale) {
+  std::ostringstream os;
+  if (!std::isfinite(residual)) {
+    os << "the residual is not finite: the solution holds NaN or infinity";
+  } else if (!(scale > 0.0) || !std::isfinite(scale)) {
+    os << "residual " << residual << " against a right-hand side of norm " << scale;
+  } else {
+    os << "relative residual " << residual / scale;
+  }
+  return os.str();
+}
+
 struct SpdSolver::Impl {
   Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> llt;  // cholmod; cg's stale factor
   Eigen::CholmodSimplicialLDLT<SparseMatrix, Eigen::Lower> ldlt;
@@ -69,8 +81,8 @@ struct SpdSolver::Impl {
     if (ldlt.info() != Eigen::Success) return StepResult::failure("the LDLT solve failed");
     const double residual = (*A * x - b).norm(), scale = b.norm();
     if (!(residual <= kResidualTolerance * scale)) {
-      return StepResult::failure("the LDLT solution is inaccurate (relative residual " +
-                                 std::to_string(residual / scale) + ")");
+      return StepResult::failure("the LDLT solution is inaccurate (" +
+                                 describeResidual(residual, scale) + ")");
     }
     return StepResult::success();
   }
@@ -320,7 +332,7 @@ StepResult SpdSolver::conjugateGradients(const Eigen::VectorXd& b, Eigen::Vector
   s.lastIterations = it;
   if (!(residual <= tolerance)) {
     std::ostringstream os;
-    os << "CG did not converge in " << it << " iterations (relative residual " << residual / bNorm
+    os << "CG did not converge in " << it << " iterations (" << describeResidual(residual, bNorm)
        << ")";
     return StepResult::failure(os.str());
   }

@@ -27,6 +27,10 @@
 
 namespace jello {
 
+// A solve's residual |A x - b| for a message: relative to |b| = `scale`, or why it cannot be
+// ("relative residual -nan" said nothing: the solution was not finite).
+std::string describeResidual(double residual, double scale);
+
 // The one table of linear solvers and the one of CG's preconditioners: enumerator, name, what
 // it is (help texts, the panel, the Python module and the studies read them from here).
 #define JELLO_LINEAR_SOLVERS(X)                                                \

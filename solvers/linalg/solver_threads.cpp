@@ -1,20 +1,46 @@
 #include "solvers/linalg/solver_threads.h"
 
-#include <unistd.h>
+#include <dlfcn.h>
 
 #include <cstdlib>
 #include <fstream>
-#include <initializer_list>
+#include <mutex>
 
 namespace jello {
+namespace {
 
-void applySolverThreadSettings(char** argv) {
-  bool changed = false;
-  for (const char* name : {"OMP_THREAD_LIMIT", "OPENBLAS_NUM_THREADS"}) {
-    if (!std::getenv(name)) changed |= ::setenv(name, "1", 0) == 0;
-  }
-  if (!std::getenv("OMP_WAIT_POLICY")) changed |= ::setenv("OMP_WAIT_POLICY", "passive", 0) == 0;
-  if (changed) ::execv("/proc/self/exe", argv);  // returns only on failure: run as we are
+std::string settings = "libraries' defaults";
+
+// A function of a library this process loaded, or null.
+template <class F>
+F loadedFunction(const char* name) {
+  return reinterpret_cast<F>(::dlsym(RTLD_DEFAULT, name));
+}
+
+}  // namespace
+
+void applySolverThreadSettings() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    std::string made;
+    if (!std::getenv("OPENBLAS_NUM_THREADS")) {
+      if (const auto set = loadedFunction<void (*)(int)>("openblas_set_num_threads")) {
+        set(1);
+        made = "openblas 1 thread";
+      }
+    }
+    if (!std::getenv("OMP_THREAD_LIMIT") && !std::getenv("OMP_NUM_THREADS")) {
+      if (const auto set = loadedFunction<void (*)(int)>("omp_set_max_active_levels")) {
+        set(0);
+        made += std::string(made.empty() ? "" : "; ") + "openmp serial";
+      }
+    }
+    if (!made.empty()) settings = made;
+  });
+}
+
+std::string solverThreadSettings() {
+  return settings;
 }
 
 std::string loadedBlas() {

@@ -1,17 +1,21 @@
 #include "src/base/atomic_file.h"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 namespace jello {
 namespace {
@@ -131,10 +135,37 @@ void writeAll(const std::filesystem::path& path, int fd, std::string_view conten
   }
 }
 
-// A device, FIFO or socket: written where it is, as a shell redirection would.
+// "10 s": how long a FIFO was waited for.
+std::string waited(double seconds) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g s", seconds);
+  return text;
+}
+
+// A device or FIFO: written where it is, as a shell redirection would. A FIFO nobody reads
+// (open fails with ENXIO when non-blocking) is waited for, then refused: a blocking open waited
+// forever.
 void writeInPlace(const std::filesystem::path& path, std::string_view contents) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY);
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(testing::fifoWaitSeconds);
+  int fd = -1;
+  while ((fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK)) < 0 &&
+         errno == ENXIO && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  if (fd < 0 && errno == ENXIO) {
+    throw std::runtime_error("cannot write " + path.string() +
+                             ": it is a FIFO that no process reads (waited " +
+                             waited(testing::fifoWaitSeconds) + ")");
+  }
   if (fd < 0) fail(path, "open", errno);
+  // Written blocking, as a redirection is: a reader that is slow is waited for.
+  const int flags = ::fcntl(fd, F_GETFL);
+  if (flags < 0 || ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0) {
+    const int err = errno;
+    ::close(fd);
+    fail(path, "fcntl", err);
+  }
   try {
     writeAll(path, fd, contents);
   } catch (...) {
@@ -165,6 +196,7 @@ std::filesystem::path followLinks(const std::filesystem::path& path) {
 
 namespace testing {
 void (*afterTemporaryCreated)() = nullptr;
+double fifoWaitSeconds = kFifoWaitSeconds;
 }  // namespace testing
 
 void writeFileAtomically(const std::filesystem::path& path, std::string_view contents) {
@@ -219,8 +251,11 @@ std::string outputProblem(const std::filesystem::path& path) {
   const std::filesystem::path& file = ec ? path : target;
   const auto status = std::filesystem::status(file, ec);
   if (std::filesystem::is_directory(status)) return "it is a directory";
+  if (std::filesystem::is_socket(status)) {
+    return "it is a socket (an output may be a file, a device or a FIFO)";
+  }
   if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
-    // A device, FIFO or socket is written in place.
+    // A device or FIFO is written in place.
     return ::access(file.c_str(), W_OK) == 0 ? "" : std::strerror(errno);
   }
   std::filesystem::path dir = file.parent_path();
@@ -233,6 +268,31 @@ std::string outputProblem(const std::filesystem::path& path) {
     return "the directory " + dir.string() + " is not writable (" + std::strerror(errno) + ")";
   }
   return "";
+}
+
+FifoReadHold::FifoReadHold(const std::filesystem::path& path) {
+  const double seconds = testing::fifoWaitSeconds;
+  std::error_code ec;
+  if (!std::filesystem::is_fifo(std::filesystem::status(path, ec))) return;
+  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd_ < 0) {
+    problem_ = std::string("cannot open: ") + std::strerror(errno);
+    return;
+  }
+  // Until a writer opens it, poll() reports nothing (no POLLHUP either): wait for POLLIN (data)
+  // or POLLHUP (a writer came and went).
+  pollfd p{fd_, POLLIN, 0};
+  const int ms = static_cast<int>(seconds * 1000.0);
+  int ready = 0;
+  while ((ready = ::poll(&p, 1, ms)) < 0 && errno == EINTR) {
+  }
+  if (ready <= 0) {
+    problem_ = "it is a FIFO that no process writes (waited " + waited(seconds) + ")";
+  }
+}
+
+FifoReadHold::~FifoReadHold() {
+  if (fd_ >= 0) ::close(fd_);
 }
 
 }  // namespace jello

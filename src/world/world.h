@@ -4,6 +4,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "src/base/vec3.h"
@@ -65,6 +66,14 @@ inline constexpr int kDefaultCubeResolution = 8;
 // divergence bound (solvers/simulation.h) is the same distance.
 inline constexpr double kStartBound = 100.0;  // the only one the original format knows
 
+// Where the reader found a setting a later check may refuse (Model::startProblem): its name
+// ("kElastic", "kCollision", "plane", "sphere", "cone", "spiral", "contact"), line and token.
+struct SourcePlace {
+  std::string what;
+  int line = 0;
+  std::string token;
+};
+
 struct World {
   IntegratorKind integrator = IntegratorKind::RK4;
   // The file's integrator name when it was not one of ours and the reader was told to accept
@@ -86,10 +95,20 @@ struct World {
   std::optional<Sphere> sphere;
   std::optional<Cone> cone;
   std::optional<Spiral> spiral;
+  // The file's places of the settings above, in reading order; empty for a world not read from
+  // a file. Never written back.
+  std::vector<SourcePlace> sources;
 
   int numPoints() const { return cubeResolution * cubeResolution * cubeResolution; }
   // True when a file of this world needs the extension block (so the original loader would
   // not read it as written).
+  // The place the reader recorded for `what`, or null.
+  const SourcePlace* sourceOf(std::string_view what) const {
+    for (const SourcePlace& p : sources) {
+      if (p.what == what) return &p;
+    }
+    return nullptr;
+  }
   bool usesExtensions() const {
     return cubeResolution != kDefaultCubeResolution || sphere.has_value() || cone.has_value() ||
            spiral.has_value() || contact.model != ContactModel::Penalty ||

@@ -11,6 +11,7 @@
 #include <tuple>
 #include <vector>
 
+#include "src/base/atomic_file.h"
 #include "src/world/world_tokenizer.h"
 
 namespace jello {
@@ -177,6 +178,7 @@ void readExtensions(Tokenizer& in, Token keyword, World& world, const ReaderLimi
       in.fail(keyword, "extension '" + std::string(e->keyword) + "' given twice");
     }
     seen.push_back(e->keyword);
+    world.sources.push_back({std::string(e->keyword), keyword.line, std::string(keyword.text)});
     e->read(in, world, limits);
     keyword = in.next();
   }
@@ -208,9 +210,11 @@ std::string displayToken(std::string_view token, std::size_t limit, bool keepUtf
 
 WorldFileError::WorldFileError(std::string file, int line, std::string token,
                                const std::string& message, std::size_t tokenBytes)
-    : std::runtime_error(displayToken(file, file.size(), true) + ":" + std::to_string(line) + ": " +
-                         message + " (at '" +
-                         displayToken(token, kShownTokenBytes, false, tokenBytes) + "')"),
+    // Line 0 is the file as a whole (it cannot be opened, it is too large): no ":0".
+    : std::runtime_error(displayToken(file, file.size(), true) +
+                         (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " + message +
+                         " (at '" + displayToken(token, kShownTokenBytes, false, tokenBytes) +
+                         "')"),
       file_(std::move(file)),
       line_(line),
       token_(displayToken(token, kShownTokenBytes, false, tokenBytes)) {}
@@ -246,6 +250,8 @@ void readHeader(Tokenizer& in, const ReaderLimits& limits, World& w) {
   w.dCollision = in.nonNegative("dCollision");
   constants[3] = in.lastToken();
   const int constantsLine = in.lastToken().line;
+  w.sources.push_back({"kElastic", constants[0].line, constants[0].text});
+  w.sources.push_back({"kCollision", constants[2].line, constants[2].text});
   w.mass = in.positive("the point mass");
   // Line breaks carry no meaning, but a mass on the constants' line usually means that line has
   // too many numbers, which is what to say when the plane flag then fails.
@@ -280,6 +286,7 @@ void readHeader(Tokenizer& in, const ReaderLimits& limits, World& w) {
     p.d = in.number("plane d");
     if (p.a == 0.0 && p.b == 0.0 && p.c == 0.0) in.fail(first, "the plane normal (a,b,c) is zero");
     w.plane = p;
+    w.sources.push_back({"plane", first.line, first.text});
   }
 }
 
@@ -299,11 +306,15 @@ void readField(Tokenizer& in, const ReaderLimits& limits, World& w) {
                           " (" + std::to_string(nodes) + " nodes)");
   }
   w.field.resolution = res;
-  w.field.forces.resize(nodes);  // at most 128^3 nodes (50 MB), and the file holds them
-  for (Vec3& f : w.field.forces) {
+  // Allocated as the numbers arrive: from a pipe, whose size is unknown, a resolution of 1024
+  // allocated 25 GB before the first number was read.
+  w.field.forces.reserve(std::min<std::size_t>(nodes, std::size_t{1} << 16));
+  for (std::size_t i = 0; i < nodes; ++i) {
+    Vec3 f;
     f.x = in.number("force-field x");
     f.y = in.number("force-field y");
     f.z = in.number("force-field z");
+    w.field.forces.push_back(f);
   }
 }
 
@@ -360,28 +371,37 @@ void assignCube(Tokenizer& in, const std::vector<double>& values, const TokenLog
     w.positions[p] = {values[3 * p], values[3 * p + 1], values[3 * p + 2]};
     const std::size_t q = 3 * (points + p);
     w.velocities[p] = {values[q], values[q + 1], values[q + 2]};
-    const Vec3& x = w.positions[p];
-    if (std::hypot(x.x, x.y, x.z) > kStartBound) {
-      in.fail(tokens[3 * p], "point " + std::to_string(p) + " starts " +
-                                 metres(std::hypot(x.x, x.y, x.z)) +
-                                 " m from the origin (at most " + metres(kStartBound) +
-                                 " m: the box is [-2,2]^3)");
-    }
-    const Vec3& v = w.velocities[p];
-    if (!std::isfinite(0.5 * w.mass * (v.x * v.x + v.y * v.y + v.z * v.z))) {
-      in.fail(tokens[q],
-              "point " + std::to_string(p) + "'s velocity gives it an infinite kinetic energy");
-    }
+  }
+  if (const std::optional<PointProblem> bad = positionsProblem(w.positions)) {
+    const std::string first = bad->other != bad->point
+                                  ? " (point " + std::to_string(bad->other) + " on line " +
+                                        std::to_string(tokens[3 * bad->other].line) + ")"
+                                  : std::string();
+    in.fail(tokens[3 * bad->point], bad->message + first);
+  }
+  if (const std::optional<PointProblem> bad = velocitiesProblem(w.velocities, w.mass)) {
+    in.fail(tokens[3 * (points + bad->point)], bad->message);
   }
 }
 
-// Two points at one place: the springs between them would have no direction (0/0).
-void refuseCoincidentPoints(Tokenizer& in, const TokenLog& tokens, const World& w) {
-  const std::size_t points = w.positions.size();
+}  // namespace
+
+std::optional<PointProblem> positionsProblem(const std::vector<Vec3>& positions) {
+  const std::size_t points = positions.size();
+  for (std::size_t p = 0; p < points; ++p) {
+    const Vec3& x = positions[p];
+    const double r = std::hypot(x.x, x.y, x.z);
+    if (!(r <= kStartBound)) {
+      return PointProblem{p, p,
+                          "point " + std::to_string(p) + " starts " + metres(r) +
+                              " m from the origin (at most " + metres(kStartBound) +
+                              " m: the box is [-2,2]^3)"};
+    }
+  }
   std::vector<std::size_t> order(points);
   for (std::size_t p = 0; p < points; ++p) order[p] = p;
   const auto key = [&](std::size_t p) {
-    const Vec3& x = w.positions[p];
+    const Vec3& x = positions[p];
     return std::tuple(x.x, x.y, x.z);
   };
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
@@ -390,13 +410,27 @@ void refuseCoincidentPoints(Tokenizer& in, const TokenLog& tokens, const World& 
   for (std::size_t i = 1; i < points; ++i) {
     const std::size_t a = order[i - 1], b = order[i];
     if (key(a) == key(b)) {
-      in.fail(tokens[3 * b], "points " + std::to_string(a) + " (line " +
-                                 std::to_string(tokens[3 * a].line) + ") and " + std::to_string(b) +
-                                 " start at the same position: the springs between them would "
-                                 "have no direction");
+      return PointProblem{b, a,
+                          "points " + std::to_string(a) + " and " + std::to_string(b) +
+                              " start at the same position: the springs between them would "
+                              "have no direction"};
     }
   }
+  return std::nullopt;
 }
+
+std::optional<PointProblem> velocitiesProblem(const std::vector<Vec3>& velocities, double mass) {
+  for (std::size_t p = 0; p < velocities.size(); ++p) {
+    const Vec3& v = velocities[p];
+    if (!std::isfinite(0.5 * mass * (v.x * v.x + v.y * v.y + v.z * v.z))) {
+      return PointProblem{
+          p, p, "point " + std::to_string(p) + "'s velocity gives it an infinite kinetic energy"};
+    }
+  }
+  return std::nullopt;
+}
+
+namespace {
 
 World parseTokens(Tokenizer& in, const ReaderLimits& limits) {
   World w;
@@ -407,7 +441,6 @@ World parseTokens(Tokenizer& in, const ReaderLimits& limits) {
   const Token keyword = readCubeNumbers(in, limits, values, tokens);
   readExtensions(in, keyword, w, limits);
   assignCube(in, values, tokens, keyword.line, w);
-  refuseCoincidentPoints(in, tokens, w);
   return w;
 }
 
@@ -448,6 +481,9 @@ World readWorld(const std::filesystem::path& path, const ReaderLimits& limits) {
       throw reader::fileTooLarge(name, limits.maxFileBytes);
     }
   }
+  // A FIFO no process writes would block the open below forever.
+  const FifoReadHold hold(path);
+  if (!hold.problem().empty()) throw WorldFileError(name, 0, name, hold.problem());
   std::ifstream file(path, std::ios::binary);
   if (!file) throw WorldFileError(name, 0, name, "cannot open for reading");
   StreamSource source(file, name);

@@ -5,9 +5,11 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "src/world/world.h"
 
@@ -47,6 +49,18 @@ class WorldFileError : public std::runtime_error {
   int line_;
   std::string token_;
 };
+
+// The reader's checks of a cube's start, which the Python module's setters share: a point
+// farther than kStartBound from the origin (or not finite), two points at one place (the springs
+// between them would have no direction; `other` is the first of them), a velocity whose kinetic
+// energy is not finite. `point` is the one to blame.
+struct PointProblem {
+  std::size_t point = 0;
+  std::size_t other = 0;
+  std::string message;
+};
+std::optional<PointProblem> positionsProblem(const std::vector<Vec3>& positions);
+std::optional<PointProblem> velocitiesProblem(const std::vector<Vec3>& velocities, double mass);
 
 // Throws WorldFileError.
 World readWorld(const std::filesystem::path& path, const ReaderLimits& limits = {});

@@ -60,6 +60,31 @@ def test_ctrl_c_stops_a_long_run_at_a_step_boundary(jello_w):
     sim.step()  # and it goes on from there
 
 
+def test_ctrl_c_stops_inside_one_long_step_and_keeps_its_start(worlds_dir):
+    """Issue 41, item 8: one cvode step of 10 s on the stiff cube takes minutes; SIGINT a second
+    in gave no KeyboardInterrupt for 169 s. The step polls the interrupt as jello-sim's does and
+    its state stays the step's start; Python's own handler is back afterwards."""
+    world = jello.load_world(str(worlds_dir / "stiff-k1e5.w"))
+    sim = jello.Simulation(world, integrator="cvode", dt=10.0)
+    start = sim.positions.copy()
+    handler = signal.getsignal(signal.SIGINT)
+    timer = threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT))
+    started = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        sim.step(1)
+    elapsed = time.monotonic() - started
+    timer.join()
+    assert elapsed < 10.0
+    assert sim.t == 0.0 and sim.steps == 0
+    assert np.array_equal(sim.positions, start)
+    assert signal.getsignal(signal.SIGINT) is handler
+    # A later call is not interrupted by the old request.
+    sim.dt = 1e-4
+    sim.step(2)
+    assert sim.steps == 2
+
+
 def test_the_gil_is_released_while_stepping(jello_w):
     sim = jello.Simulation(jello_w, integrator="rk4")
     counter = [0]

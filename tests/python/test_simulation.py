@@ -222,5 +222,8 @@ def test_set_integrator_user_force_and_stats(jello_w):
             jello.Simulation(jello_w, integrator="cvode", **bad)
     with pytest.raises(ValueError):
         jello.Simulation(jello_w, integrator="leapfrog")
+    # An int too large for C's is a bad value, not a bad type (was "must be an integer, not int").
+    with pytest.raises(ValueError, match="newton_iters is out of range"):
+        jello.Simulation(jello_w, integrator="implicit", newton_iters=10 ** 30)
     with pytest.raises(ValueError):
         jello.Simulation(jello_w, dt=0.0)

@@ -59,3 +59,8 @@ def test_bad_arguments_are_value_errors():
         jello.stability_threshold(world, "rk4", newton_tolerance=1e-3)
     with pytest.raises(ValueError):
         jello.predicted_threshold("rk4", -1.0, 0.0)
+    # Issue 41, item 6: jello-stability's ranges (a step count that fits, no subnormal step).
+    with pytest.raises(ValueError, match="time must be between 0.0001 and 1000, not 1e\\+308"):
+        jello.stability_threshold(world, "rk4", time=1e308)
+    with pytest.raises(ValueError, match="dt_max must be between 1e-09 and 1"):
+        jello.stability_threshold(world, "rk4", dt_max=4.9e-324, dt_min=1e-330)

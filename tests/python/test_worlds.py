@@ -80,6 +80,47 @@ def test_attributes_write_and_check(jello_w, tmp_path):
         w.k = "stiff"
 
 
+def test_setters_check_as_the_reader_does_and_save_writes_only_what_loads(jello_w, worlds_dir,
+                                                                        tmp_path):
+    """Issue 41, items 5 and 7: the setters share the reader's checks of the cube's start, and
+    save() refuses a world load_world would refuse, so nothing written fails to load."""
+    w = jello_w.copy()
+    twins = w.positions
+    twins[7] = twins[3]
+    far = w.positions
+    far[5] = (1e6, 0.0, 0.0)
+    with pytest.raises(ValueError, match="points 3 and 7 start at the same position"):
+        w.positions = twins
+    with pytest.raises(ValueError, match="starts 1e\\+06 m from the origin"):
+        w.positions = far
+    with pytest.raises(ValueError, match="infinite kinetic energy"):
+        w.velocities = np.full((512, 3), 1e200)
+    fast = np.zeros((512, 3))
+    fast[0] = (1e150, 0.0, 0.0)  # 1/2 m v^2 = 2e297 J: finite, accepted
+    w.velocities = fast
+    with pytest.raises(ValueError, match="infinite kinetic energy"):
+        w.mass = 1e20  # the same velocities, now too much energy
+    assert w.mass == jello_w.mass and np.array_equal(w.positions, jello_w.positions)
+    w.save(str(tmp_path / "fast.w"))
+    assert jello.load_world(str(tmp_path / "fast.w")) == w
+
+    deep = jello_w.copy()
+    deep.sphere = (0.0, 0.0, -1.0, 1e308)  # the cube deep inside: infinite contact energy
+    with pytest.raises(jello.WorldError, match="sphere's contact energy at the start is inf"):
+        deep.save(str(tmp_path / "deep.w"))
+    assert not (tmp_path / "deep.w").exists()
+    with pytest.raises(ValueError, match="every term of the energy must be finite"):
+        jello.Simulation(deep, integrator="implicit")
+    text = (worlds_dir / "jello.w").read_text() + "sphere 0 0 -1 1e308\n"
+    (tmp_path / "deep.w").write_text(text)
+    with pytest.raises(jello.WorldError) as info:
+        jello.load_world(str(tmp_path / "deep.w"))
+    assert (info.value.line, info.value.token) == (text.count("\n"), "sphere")
+    # The system reads a path up to its first NUL: such a path is refused, not truncated.
+    with pytest.raises(ValueError, match="NUL"):
+        jello.load_world(str(worlds_dir / "jello.w") + "\0.bak")
+
+
 def test_contact_model_is_an_attribute_and_a_create_world_keyword(jello_w, tmp_path):
     assert jello_w.contact == "penalty" and jello_w.contact_layer == 0.0
     w = jello_w.copy()

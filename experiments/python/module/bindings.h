@@ -40,6 +40,12 @@ T as(const py::handle& v, const std::string& what) {
   try {
     return py::cast<T>(v);
   } catch (const py::cast_error&) {
+    // An int too large for C's: a bad value, not a bad type ("must be an integer, not int").
+    if constexpr (std::is_integral_v<T>) {
+      if (py::isinstance<py::int_>(v) && !py::isinstance<py::bool_>(v)) {
+        throw py::value_error(what + " is out of range (too large an integer)");
+      }
+    }
     const char* kind = std::is_same_v<T, std::string> ? "a string"
                        : std::is_integral_v<T>        ? "an integer"
                        : std::is_floating_point_v<T>  ? "a number"
@@ -54,6 +60,7 @@ double finite(double v, const char* what);
 double positive(double v, const char* what);
 double nonNegative(double v, const char* what);
 long inRange(long v, long lo, long hi, const char* what);
+double inRangeReal(double v, double lo, double hi, const char* what);
 IntegratorKind integratorFrom(const std::string& name);
 Vec3 vec3From(const py::handle& h, const char* what);
 
@@ -65,6 +72,20 @@ Eigen::VectorXd componentMajor(const py::handle& h, py::ssize_t n, const char* w
 std::vector<Vec3> vec3List(const py::handle& h, py::ssize_t n, const char* what);
 py::tuple vec3Tuple(const Vec3& v);
 py::dict energyDict(const Energy& e);
+
+// While a step runs without the GIL, Ctrl-C (SIGINT) also asks the step itself to stop
+// (src/base/interrupt.h, polled inside CVODE's right-hand side, Newton and projective
+// iterations), then reaches Python's own handler, which raises KeyboardInterrupt at the next
+// PyErr_CheckSignals: a step of minutes stops within a fraction of a second, as jello-sim's
+// does, its state the step's start. Nested and concurrent bridges share one installation; with
+// SIGINT ignored or at its default (the process ends anyway), none is installed.
+class SignalBridge {
+ public:
+  SignalBridge();
+  ~SignalBridge();
+  SignalBridge(const SignalBridge&) = delete;
+  SignalBridge& operator=(const SignalBridge&) = delete;
+};
 
 // Raised as jello.Diverged (jello/__init__.py), with the last sane state.
 struct DivergedError {

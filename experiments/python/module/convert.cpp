@@ -1,10 +1,14 @@
 #include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
 
 #include "experiments/python/module/bindings.h"
 #include "src/base/closed_set.h"
+#include "src/base/interrupt.h"
 #include "src/world/world_reader.h"
 
 namespace jello::python {
@@ -32,6 +36,56 @@ long inRange(long v, long lo, long hi, const char* what) {
                std::to_string(hi) + ", not " + std::to_string(v));
   }
   return v;
+}
+double inRangeReal(double v, double lo, double hi, const char* what) {
+  if (!(finite(v, what) >= lo && v <= hi)) {
+    char text[96];
+    std::snprintf(text, sizeof text, " must be between %g and %g, not %g", lo, hi, v);
+    valueError(what + std::string(text));
+  }
+  return v;
+}
+
+namespace {
+
+std::mutex bridgeMutex;
+int bridgeUsers = 0;
+bool bridgeInstalled = false;
+struct sigaction pythonSigint;  // Python's handler, restored when the last bridge ends
+
+void bridgeHandler(int signo, siginfo_t* info, void* context) {
+  jello::requestInterrupt(signo);
+  if ((pythonSigint.sa_flags & SA_SIGINFO) != 0) {
+    pythonSigint.sa_sigaction(signo, info, context);
+  } else if (pythonSigint.sa_handler != SIG_DFL && pythonSigint.sa_handler != SIG_IGN) {
+    pythonSigint.sa_handler(signo);
+  }
+}
+
+}  // namespace
+
+SignalBridge::SignalBridge() {
+  const std::lock_guard lock(bridgeMutex);
+  if (bridgeUsers++ > 0) return;
+  jello::clearInterrupt();  // a request left from before is not this call's
+  struct sigaction current {};
+  if (sigaction(SIGINT, nullptr, &current) != 0) return;
+  const bool handled = (current.sa_flags & SA_SIGINFO) != 0 ||
+                       (current.sa_handler != SIG_DFL && current.sa_handler != SIG_IGN);
+  if (!handled) return;
+  pythonSigint = current;
+  struct sigaction bridge {};
+  bridge.sa_sigaction = bridgeHandler;
+  bridge.sa_flags = SA_SIGINFO | (current.sa_flags & SA_RESTART);
+  sigemptyset(&bridge.sa_mask);
+  bridgeInstalled = sigaction(SIGINT, &bridge, nullptr) == 0;
+}
+
+SignalBridge::~SignalBridge() {
+  const std::lock_guard lock(bridgeMutex);
+  if (--bridgeUsers > 0 || !bridgeInstalled) return;
+  sigaction(SIGINT, &pythonSigint, nullptr);
+  bridgeInstalled = false;
 }
 
 IntegratorKind integratorFrom(const std::string& name) {
@@ -240,7 +294,8 @@ jello::SolverOptions solverOptionsFrom(const py::kwargs& kwargs, jello::SolverOp
     } else if (name == "stab_lim_det") {
       o.cvode.stabilityLimitDetection = boolOption(value, name);
     } else if (name == "max_step") {
-      o.cvode.maxStep = positive(real(), n);
+      o.cvode.maxStep =
+          inRangeReal(real(), CvodeOptions::kMinMaxStep, CvodeOptions::kMaxMaxStep, n);
     } else {
       valueError("unknown solver option '" + name + "' (known: " + kSolverOptionNames + ")");
     }

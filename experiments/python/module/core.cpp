@@ -16,6 +16,7 @@ namespace py = pybind11;
 using namespace py::literals;
 using jello::IntegratorKind;
 using jello::World;
+using jello::python::inRangeReal;
 using jello::python::integratorFrom;
 using jello::python::nonNegative;
 using jello::python::positive;
@@ -26,6 +27,7 @@ using jello::python::valueError;
 PYBIND11_MODULE(_core, m) {
   m.doc() = "jello's simulator core; use it through the jello package (README \"From Python\")";
   py::register_exception_translator(&jello::python::translateExceptions);
+  jello::applySolverThreadSettings();  // single-threaded BLAS and CHOLMOD, as the programs
   jello::python::bindWorlds(m);
   jello::python::bindSimulation(m);
 
@@ -86,10 +88,12 @@ PYBIND11_MODULE(_core, m) {
          const py::kwargs& options) {
         const IntegratorKind kind = integratorFrom(integrator);
         jello::experiments::BlowUpRule rule;
-        rule.time = positive(time, "time");
+        using Rule = jello::experiments::BlowUpRule;
+        rule.time = inRangeReal(time, Rule::kMinTime, Rule::kMaxTime, "time");
         rule.energyFactor = positive(energyFactor, "energy_factor");
         positive(tolerance, "tolerance");
-        if (!(positive(dtMin, "dt_min") < positive(dtMax, "dt_max"))) {
+        inRangeReal(dtMax, Rule::kMinDtMax, Rule::kMaxDtMax, "dt_max");
+        if (!(positive(dtMin, "dt_min") < dtMax)) {
           valueError("dt_min must be below dt_max");
         }
         jello::SolverOptions solver;

@@ -8,6 +8,7 @@
 
 #include "experiments/python/module/bindings.h"
 #include "solvers/system/jacobian.h"
+#include "src/base/interrupt.h"
 
 namespace jello::python {
 
@@ -42,8 +43,8 @@ class PySimulation {
              dt ? std::optional(positive(*dt, "dt")) : std::nullopt,
              solverOptionsFrom(options, {})) {
     positive(sim_.dt(), "dt");
-    if (std::string why = sim_.model().contactError(sim_.state().x.data()); !why.empty()) {
-      valueError(why);
+    if (const std::optional<jello::StartProblem> why = sim_.model().startProblem(sim_.state())) {
+      valueError(jello::startError(*why, sim_.world(), "the world").what());
     }
     sim_.trackObstacleDistance();
     energyStart_ = sim_.model().energy(sim_.state());
@@ -72,6 +73,7 @@ class PySimulation {
     long done = 0;
     bool failed = false, interrupted = false;
     {
+      const SignalBridge bridge;
       py::gil_scoped_release nogil;
       auto lastPoll = finish.t0;
       while (done < count) {
@@ -111,6 +113,10 @@ class PySimulation {
       }
     }
     if (interrupted) {
+      // Python's handler saw the signal too: it raises (KeyboardInterrupt, or what a handler of
+      // the caller's raises); if it does not, the stop still is one.
+      jello::clearInterrupt();
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
       PyErr_SetNone(PyExc_KeyboardInterrupt);
       throw py::error_already_set();
     }

@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "experiments/python/module/bindings.h"
+#include "src/model.h"
 #include "src/world/scene_builder.h"
 #include "src/world/world_reader.h"
 #include "src/world/world_writer.h"
@@ -20,7 +21,11 @@ World loadWorld(const std::string& path, int maxFieldResolution, int maxCubeReso
   jello::ReaderLimits limits;
   limits.maxFieldResolution = int(inRange(maxFieldResolution, 2, 1024, "max_field_resolution"));
   limits.maxCubeResolution = int(inRange(maxCubeResolution, 2, 256, "max_cube_resolution"));
-  return jello::readWorld(path, limits);
+  // The operating system reads a path up to its first NUL: refuse it rather than load another.
+  if (path.find('\0') != std::string::npos) valueError("the path holds a NUL character");
+  World world = jello::readWorld(path, limits);
+  jello::checkStart(world, path);  // every term of its start's energy finite
+  return world;
 }
 
 static_assert(sizeof(Vec3) == 3 * sizeof(double), "Vec3 is three packed doubles");
@@ -86,6 +91,9 @@ bool sameWorld(const World& a, const World& b) {
 }  // namespace
 
 void saveWorld(const World& w, const std::string& path, bool legacy) {
+  // What the reader would refuse is not written: the setters check each value, this the whole
+  // (a sphere that swallows the cube, an energy no step can start from).
+  jello::checkStart(w, path);
   try {
     jello::writeWorld(w, path, legacy ? jello::NumberFormat::Legacy : jello::NumberFormat::Exact);
   } catch (const std::runtime_error& e) {
@@ -336,7 +344,14 @@ void bindWorlds(py::module_& m) {
           "friction's slip speed eps_v, m/s: below it friction is static, a stiff damper")
       .def_property(
           "mass", [](const World& w) { return w.mass; },
-          [](World& w, double v) { w.mass = positive(v, "mass"); }, "mass of each point, kg")
+          [](World& w, double v) {
+            const double mass = positive(v, "mass");
+            if (const auto bad = jello::velocitiesProblem(w.velocities, mass)) {
+              valueError("with mass " + std::to_string(mass) + " kg, " + bad->message);
+            }
+            w.mass = mass;
+          },
+          "mass of each point, kg")
       .def_property(
           "plane",
           [](const World& w) -> py::object {
@@ -390,13 +405,19 @@ void bindWorlds(py::module_& m) {
       .def_property(
           "positions", [](const World& w) { return pointsArray(w.positions); },
           [](World& w, const py::object& v) {
-            w.positions = vec3List(v, w.numPoints(), "positions");
+            std::vector<Vec3> positions = vec3List(v, w.numPoints(), "positions");
+            if (const auto bad = jello::positionsProblem(positions)) valueError(bad->message);
+            w.positions = std::move(positions);
           },
           "(n, 3) initial positions, m (a copy)")
       .def_property(
           "velocities", [](const World& w) { return pointsArray(w.velocities); },
           [](World& w, const py::object& v) {
-            w.velocities = vec3List(v, w.numPoints(), "velocities");
+            std::vector<Vec3> velocities = vec3List(v, w.numPoints(), "velocities");
+            if (const auto bad = jello::velocitiesProblem(velocities, w.mass)) {
+              valueError(bad->message);
+            }
+            w.velocities = std::move(velocities);
           },
           "(n, 3) initial velocities, m/s (a copy)")
       .def("save", &saveWorld, "path"_a, "legacy"_a = false,

@@ -12,14 +12,9 @@ D are 3n x 3n scipy.sparse matrices in the state's component-major ordering: row
 component c of point p, so `forces.T.ravel()` lines up with their rows.
 """
 
-import os as _os
-
-# CHOLMOD's and OpenBLAS's thread pools only cost at this problem's sizes (solvers/
-# solver_threads.h): single-threaded unless the user chose otherwise. They are read when the
-# libraries load, so this only takes effect when numpy's BLAS is not loaded yet.
-for _name, _value in (("OMP_THREAD_LIMIT", "1"), ("OPENBLAS_NUM_THREADS", "1"),
-                      ("OMP_WAIT_POLICY", "passive")):
-    _os.environ.setdefault(_name, _value)
+# CHOLMOD's and OpenBLAS's thread pools only cost at this problem's sizes: the module sets both
+# to one thread as it loads, by the libraries' own calls, unless the user chose otherwise
+# (solvers/linalg/solver_threads.h).
 
 
 class WorldError(ValueError):
