@@ -4,7 +4,7 @@
 # (assertions and validations on), leaving out the tests labelled slow, soak and experiments
 # (minutes of simulation, 5-10x slower sanitized) and programs (the programs run as processes:
 # their code is the libraries', tested in-process, and the option parsing, fuzzed). JELLO_WERROR=ON makes warnings errors.
-# Arguments after the preset go to ctest (CI: `scripts/test.sh release --label-exclude soak`).
+# Arguments after the preset go to ctest (CI: `scripts/test.sh release --label-exclude "soak|sweep"`).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 preset=${1:-release}
@@ -17,5 +17,5 @@ jobs=$(env -u OMP_NUM_THREADS -u OMP_THREAD_LIMIT nproc)
 # Single-threaded BLAS and CHOLMOD, as jello-sim runs them (solvers/linalg/solver_threads.h).
 export OMP_THREAD_LIMIT=${OMP_THREAD_LIMIT:-1} OPENBLAS_NUM_THREADS=${OPENBLAS_NUM_THREADS:-1}
 exclude=()
-[ "$preset" = asan ] && exclude=(--label-exclude "slow|soak|experiments|programs")
+[ "$preset" = asan ] && exclude=(--label-exclude "slow|soak|sweep|experiments|programs")
 ctest --preset "$preset" -j"$jobs" "${exclude[@]}" "$@"

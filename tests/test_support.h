@@ -10,6 +10,15 @@
 
 namespace jello::test {
 
+// True in the sanitizer build, whose runs are 5-10x slower (and validated at every step): the
+// few tests that loop over many random cases or long runs do a share of them there, the release
+// run all of them.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kSanitized = true;
+#else
+inline constexpr bool kSanitized = false;
+#endif
+
 std::filesystem::path worldsDir();
 World loadWorld(const std::string& name);  // a file of worlds/
 std::string readFile(const std::filesystem::path& path);
