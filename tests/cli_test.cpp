@@ -770,6 +770,22 @@ TEST(Experiments, StabilityRefusesTimesAndStepsItCannotRun) {
   }
 }
 
+// Issue 41, item 6 for jello-scaling: a budget of 1e308 s never ended and a step of 4.9e-324 s
+// never moved the clock; each is refused with its range (exit 2).
+TEST(Experiments, ScalingRefusesBudgetsAndStepsItCannotRun) {
+  const std::filesystem::path bin = std::filesystem::path(sim()).parent_path();
+  if (!std::filesystem::exists(bin / "jello-scaling")) GTEST_SKIP() << "not built here";
+  test::TempDir dir;
+  for (const char* bad :
+       {"--budget 1e308", "--budget 4.9e-324", "--implicit-dt 4.9e-324", "--implicit-dt 1e300",
+        "--atlas-budget 1e308", "--atlas-checkpoint 1e-300"}) {
+    const Outcome r = run((bin / "jello-scaling").string() + " --quick --quiet " + bad +
+                          " --out-dir " + dir.path().string() + " 2>&1");
+    EXPECT_EQ(r.code, 2) << bad << "\n" << r.output;
+    EXPECT_TRUE(contains(r.output, "must be at")) << bad << "\n" << r.output;
+  }
+}
+
 // Issue 41 (low): `--name ../escape` or an absolute --name wrote outside --out-dir, `--name ''`
 // wrote hidden files (".csv"); cvode's --max-step 4.9e-324 was silently no limit.
 TEST(Experiments, NameIsAStemInTheOutputDirectoryAndMaxStepIsNotSubnormal) {

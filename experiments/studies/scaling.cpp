@@ -61,12 +61,14 @@ void addGridOptions(CLI::App& app, Options& opt) {
   app.add_option("--k", opt.k, "Spring stiffness, N/m")
       ->check(jello::cli::positive())
       ->capture_default_str();
+  // Bounded as jello-stability's times and steps are (issue 41, item 6): a budget of 1e308 s
+  // never ends, a step of 4.9e-324 s never moves the clock.
   app.add_option("--budget", opt.budget, "Wall seconds to run each point for (at least one step)")
-      ->check(jello::cli::positive())
+      ->check(jello::cli::range(1e-3, 1e6))
       ->capture_default_str();
   app.add_option("--implicit-dt", opt.implicitDt,
                  "Time step of implicit, output interval of cvode, s")
-      ->check(jello::cli::positive())
+      ->check(jello::cli::range(1e-9, 1.0))
       ->capture_default_str();
   app.add_option("--rtol", opt.rtol, "cvode's relative tolerance")
       ->check(jello::cli::positive())
@@ -98,7 +100,7 @@ void addAtlasOptions(CLI::App& app, Options& opt) {
       ->capture_default_str();
   app.add_option("--atlas-budget", opt.atlas.runBudget,
                  "Wall seconds of one atlas run beyond which smaller steps are not tried")
-      ->check(jello::cli::positive())
+      ->check(jello::cli::range(1e-3, 1e6))
       ->capture_default_str();
   app.add_option("--atlas-references", opt.referenceDir,
                  "Directory the atlas's RK4 references are read from, or written to once computed "
@@ -106,7 +108,7 @@ void addAtlasOptions(CLI::App& app, Options& opt) {
                  "resumes there)");
   app.add_option("--atlas-checkpoint", opt.atlas.checkpoint,
                  "Wall seconds between the saved states of a reference being computed")
-      ->check(jello::cli::positive())
+      ->check(jello::cli::range(1e-3, 1e6))
       ->capture_default_str();
   app.add_option("--atlas-reference-threads", opt.atlas.referenceThreads,
                  "Threads of the model while a reference is computed, with --jobs 1 (default: the "

@@ -2,10 +2,14 @@
 // scripts/fuzz.sh with clang 14 under AddressSanitizer and UndefinedBehaviorSanitizer.
 // Contract: any input either parses into a consistent world or throws WorldFileError; a world
 // accepted builds its model (springs, field, plane, sphere, cone and spiral obstacles) and its
-// forces, energy and contact test evaluate without undefined behaviour at its start.
+// forces, energy and contact test evaluate without undefined behaviour at its start; the start
+// check the programs and the Python module make after loading (Model::startProblem, naming the
+// setting's line) either passes or names a setting the reader recorded, and the reader's point
+// checks, which the Python setters share, pass on what it accepted.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
+#include <optional>
 #include <string_view>
 
 #include "src/model.h"
@@ -36,5 +40,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   model.forces(s.x, s.v, f);
   (void)model.energy(s.x, s.v);
   (void)model.inContact(s.x.data());
+  if (jello::positionsProblem(w.positions) || jello::velocitiesProblem(w.velocities, w.mass)) {
+    std::abort();  // the setters' checks refuse what the reader accepted
+  }
+  if (const std::optional<jello::StartProblem> problem = model.startProblem(s)) {
+    const jello::WorldFileError e = jello::startError(*problem, w, "fuzz");
+    if (e.line() == 0 && problem->what != "velocities") std::abort();  // a line it cannot name
+  }
   return 0;
 }
