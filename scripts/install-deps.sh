@@ -11,7 +11,7 @@ packages=(
   libspectra-dev libcli11-dev nlohmann-json3-dev gnuplot-nox libopenmpi-dev openmpi-bin
   clang-14 libclang-rt-14-dev clang-format-14
   python3 python3-dev pybind11-dev python3-numpy python3-scipy python3-matplotlib python3-pytest
-  python3-hypothesis python3-pip python3-setuptools python3-wheel python3-venv
+  python3-hypothesis python3-pip python3-setuptools python3-wheel python3-venv ffmpeg
 )
 
 missing=()

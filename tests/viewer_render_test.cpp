@@ -278,6 +278,53 @@ TEST(Recording, ThirtyFramesAreThirtyValidChangingJpegs) {
   EXPECT_EQ(files, 30u);  // no temporary left behind
 }
 
+// Issue 40, item 6: a video a user can share. ffprobe decodes what --record-video wrote: every
+// frame, at the window's size (an odd one padded to even for yuv420p), at 15 frames/s; with
+// --record the JPEGs too; a diverging recording leaves no video and no temporary file.
+TEST(Recording, AVideoHoldsEveryRecordedFrame) {
+  test::TempDir dir;
+  const auto probe = [](const std::filesystem::path& video) {
+    return run("ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+               "stream=codec_name,width,height,nb_read_frames,r_frame_rate -of csv=p=0 " +
+               video.string())
+        .output;
+  };
+  const auto mp4 = dir.path() / "jello.mp4";
+  Outcome r = run(headless(world("jello.w") + " --frames 20 --record-video " + mp4.string() +
+                           " --record " + (dir.path() / "frames").string()));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("wrote 20 frames to " + (dir.path() / "frames").string() + " and " +
+                          mp4.string()),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(probe(mp4), "h264,640,480,15/1,20\n");
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "frames" / "019.jpg"));
+
+  const auto webm = dir.path() / "odd.webm";
+  r = run(
+      headless(world("jello.w") + " --frames 12 --size 321x241 --record-video " + webm.string()));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(probe(webm), "vp8,322,242,15/1,12\n");
+
+  const auto diverged = dir.path() / "diverged.mp4";
+  r = run(headless(world("jello.w") +
+                   " --integrator euler --dt 0.01 --frames 100 "
+                   "--record-video " +
+                   diverged.string()));
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(diverged));
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir.path())) ++files;
+  EXPECT_EQ(files, 3u);  // jello.mp4, frames/, odd.webm: no temporary left behind
+
+  for (const char* bad : {"v.avi", "missing/v.mp4"}) {
+    r = run(
+        headless(world("jello.w") + " --frames 2 --record-video " + (dir.path() / bad).string()));
+    EXPECT_EQ(r.code, 2) << bad << "\n" << r.output;
+  }
+  EXPECT_EQ(run(headless(world("jello.w") + " --frames 2")).code, 2);  // frames of nothing
+}
+
 TEST(Recording, EveryIntegratorAndTheSphereSceneRecord) {
   test::TempDir dir;
   for (const char* integrator : {"euler", "symplectic", "rk4", "implicit", "cvode"}) {

@@ -17,6 +17,7 @@
 #include "src/model.h"
 #include "src/world/world_reader.h"
 #include "viewer/texture.h"
+#include "viewer/video_writer.h"
 #include "viewer/viewer_app.h"
 #include "viewer/viewer_state.h"
 
@@ -51,10 +52,19 @@ void addOptions(CLI::App& app, jello::viewer::ViewerOptions& opt, Args& args) {
                                               : std::string();
                          },
                          "DIR", "non-empty"));
-  app.add_option("--frames", opt.frames, "Number of frames to record (1-300: 15 per second)")
-      ->check(jello::cli::range(1, jello::viewer::kMaxRecordedFrames))
-      ->needs(record);
+  auto* video =
+      app.add_option("--record-video", opt.recordVideo,
+                     "Encode the recorded frames into this video with ffmpeg (.mp4: H.264, .webm: "
+                     "VP8; 15 frames/s) and exit; with --record, the JPEGs too")
+          ->check(CLI::Validator(
+              [](const std::string& file) { return jello::viewer::VideoWriter::problem(file); },
+              "FILE"));
+  app.add_option("--frames", opt.frames,
+                 "Number of frames to record (1-300: 15 per second; needs --record or "
+                 "--record-video)")
+      ->check(jello::cli::range(1, jello::viewer::kMaxRecordedFrames));
   record->needs("--frames");
+  video->needs("--frames");
   app.add_option("--compare", args.compare,
                  "Run these integrators (2-6, comma-separated, e.g. rk4,implicit) side by side in "
                  "split panes, at one shared simulated time")
@@ -80,7 +90,8 @@ void addOptions(CLI::App& app, jello::viewer::ViewerOptions& opt, Args& args) {
   app.add_option("--benchmark", opt.benchmarkFrames,
                  "Draw this many frames as fast as possible, print frames/s and exit")
       ->check(jello::cli::positive())
-      ->excludes(record);
+      ->excludes(record)
+      ->excludes(video);
   app.add_option("--max-field-resolution", opt.source.limits.maxFieldResolution,
                  "Largest force-field resolution a world may ask for")
       ->check(jello::cli::range(2, 1024))
@@ -128,6 +139,9 @@ std::string apply(const Args& args, jello::viewer::ViewerOptions& opt) {
     }
   }
   if (args.panel || args.noPanel) opt.panel = args.panel;
+  if (opt.frames > 0 && opt.recordDir.empty() && opt.recordVideo.empty()) {
+    return "--frames needs --record DIR or --record-video FILE";
+  }
   if (!opt.texture.empty() && opt.texture != "builtin") {
     try {
       (void)jello::viewer::loadTexture(opt.texture);

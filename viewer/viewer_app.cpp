@@ -139,6 +139,23 @@ void Viewer::capture(const std::filesystem::path& path) {
   writeJpeg(path, imageFromBottomUp(viewport_.width, viewport_.height, readBackBuffer(viewport_)));
 }
 
+void Viewer::recordFrame() {
+  const Image image =
+      imageFromBottomUp(viewport_.width, viewport_.height, readBackBuffer(viewport_));
+  if (!options_.recordDir.empty()) {
+    char name[16];
+    std::snprintf(name, sizeof name, "%03d.jpg", framesDrawn_);
+    writeJpeg(options_.recordDir / name, image);
+  }
+  if (!options_.recordVideo.empty()) {
+    if (!video_) {
+      video_ = std::make_unique<VideoWriter>(options_.recordVideo, image.width, image.height,
+                                             kRecordedFramesPerSecond);
+    }
+    video_->add(image);
+  }
+}
+
 // Long: one frame's drawing, pane by pane, in the order GL needs it.
 void Viewer::display() {
   if (recording()) waitForRecordedFrame();
@@ -173,10 +190,8 @@ void Viewer::display() {
     screenshot();
   }
   if (recording()) {
-    char name[16];
-    std::snprintf(name, sizeof name, "%03d.jpg", framesDrawn_);
     try {
-      capture(options_.recordDir / name);
+      recordFrame();
     } catch (const std::exception& e) {
       std::cerr << "jello: " << e.what() << '\n';
       return leave(1);
@@ -209,10 +224,23 @@ void Viewer::display() {
     if (framesDrawn_ >= target) {
       if (recording()) {
         if (::isatty(STDERR_FILENO)) std::fprintf(stderr, "\n");
+        if (video_) {
+          try {
+            video_->finish();
+          } catch (const std::exception& e) {
+            std::cerr << "jello: " << e.what() << '\n';
+            return leave(1);
+          }
+        }
+        const std::string where =
+            options_.recordDir.empty() ? options_.recordVideo.string()
+            : options_.recordVideo.empty()
+                ? options_.recordDir.string()
+                : options_.recordDir.string() + " and " + options_.recordVideo.string();
         std::printf(
             "jello: wrote %d frames to %s: simulated t = %.4g .. %.4g s (%s, %.4g s per frame; "
             "%.4g s of animation at 15 frames/s)\n",
-            framesDrawn_, options_.recordDir.c_str(), recordStart_, latestTime(),
+            framesDrawn_, where.c_str(), recordStart_, latestTime(),
             options_.courseTime ? "course time" : ("speed " + format("%.4g", view_.speed)).c_str(),
             recordSpan_, framesDrawn_ / kRecordedFramesPerSecond);
       } else {

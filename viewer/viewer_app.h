@@ -1,6 +1,7 @@
 // The interactive viewer: a GLUT window over a SimRunner (the simulation on its own thread),
 // with the keys of viewer_state.h, mouse push and pull, reload, screenshots, recording to
-// numbered JPEGs (15 per simulated second times the speed) and a frame-rate benchmark. The only
+// numbered JPEGs and/or a video (15 frames per simulated second times the speed) and a
+// frame-rate benchmark. The only
 // file besides renderer.cpp and panel.cpp that talks to GLUT.
 #pragma once
 
@@ -18,8 +19,9 @@ namespace jello::viewer {
 inline constexpr int kMaxRecordedFrames = 300;  // the course's rule: 15 frames per second
 
 struct ViewerOptions {
-  SceneSource source;               // the world file and its overrides
-  std::filesystem::path recordDir;  // non-empty: record `frames` frames and exit
+  SceneSource source;                 // the world file and its overrides
+  std::filesystem::path recordDir;    // non-empty: record `frames` frames and exit
+  std::filesystem::path recordVideo;  // non-empty: the same frames as a video (.mp4, .webm)
   int frames = 0;
   Viewport size;
   double speed = 1.0;             // playback: simulated seconds per wall second

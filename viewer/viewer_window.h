@@ -19,6 +19,7 @@
 #include "viewer/runner_group.h"
 #include "viewer/sim_runner.h"
 #include "viewer/texture.h"
+#include "viewer/video_writer.h"
 #include "viewer/viewer_app.h"
 #include "viewer/viewer_state.h"
 
@@ -51,7 +52,7 @@ inline std::optional<std::string> freeName(const char* pattern) {
 
 inline SimRunner::Options runnerOptions(const ViewerOptions& options) {
   SimRunner::Options r;
-  const bool recording = !options.recordDir.empty();
+  const bool recording = !options.recordDir.empty() || !options.recordVideo.empty();
   r.pacing = recording || options.courseTime ? Pacing::Target : Pacing::RealTime;
   r.speed = options.speed;
   return r;
@@ -104,9 +105,11 @@ class Viewer {
   int exitCode() const { return exitCode_; }
 
  private:
-  bool recording() const { return !options_.recordDir.empty(); }
+  bool recording() const { return !options_.recordDir.empty() || !options_.recordVideo.empty(); }
   void waitForRecordedFrame();
   void capture(const std::filesystem::path& path);
+  // This frame into the recording: frames/NNN.jpg and/or the video. Throws on a failed write.
+  void recordFrame();
   void screenshot();
   void notify(std::string message, bool alarm) {
     message_ = std::move(message);
@@ -160,6 +163,7 @@ class Viewer {
   bool screenshotPending_ = false;
   int framesDrawn_ = 0;
   double recordSpan_ = 0.0, recordStart_ = 0.0;
+  std::unique_ptr<VideoWriter> video_;  // --record-video, started at the first frame
   long drawnPublished_ = -1;
 
   enum class Drag { None, Rotate, Pan, Push, Pull } drag_ = Drag::None;
