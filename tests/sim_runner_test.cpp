@@ -130,6 +130,26 @@ TEST(SimRunner, ASimulationThatFallsBehindDropsTimeAndSaysItLags) {
   EXPECT_TRUE(f.lagging);
 }
 
+// Issue 40, item 5: right after a reload the heads-up said "behind: simulating -60.8 s per wall
+// second": the rate was measured across the reload, whose time starts over. It starts over too.
+TEST(SimRunner, TheRateStartsOverAtAReloadInsteadOfGoingNegative) {
+  FakeClock clock;
+  SimRunner runner(source("jello.w"), test::loadWorld("jello.w"), fakeClockOptions(clock, 1.0));
+  for (int i = 1; i <= 10; ++i) {
+    clock.advance(0.05);
+    ASSERT_TRUE(runner.waitFor(0.05 * i - runner.frame().dt, 30.0));
+  }
+  runner.sync();
+  EXPECT_GT(runner.frame().simRate, 0.5);
+  EXPECT_GT(runner.frame().rateSpan, 0.25);
+  runner.post([](ViewerSession& s) { ASSERT_FALSE(s.reload().has_value()); }, true);
+  runner.sync();
+  const Frame f = runner.frame();
+  EXPECT_LT(f.state.t, 0.1);
+  EXPECT_GE(f.simRate, 0.0);
+  EXPECT_LT(f.rateSpan, 0.25);  // too short to say the simulation is behind
+}
+
 TEST(SimRunner, RecordingCoversTwentySecondsInThreeHundredFrames) {
   // A 3^3 cube: 20 simulated seconds are 20,000 cheap steps (the pacing is what is tested).
   SceneSpec spec;

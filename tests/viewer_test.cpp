@@ -2,8 +2,10 @@
 // the box, the mouse's forces, key handling and the session's reload.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <random>
 
 #include "src/world/world_writer.h"
@@ -12,6 +14,7 @@
 #include "viewer/camera.h"
 #include "viewer/image_writer.h"
 #include "viewer/interaction.h"
+#include "viewer/panel.h"
 #include "viewer/surface.h"
 #include "viewer/texture.h"
 #include "viewer/viewer_session.h"
@@ -408,6 +411,43 @@ TEST(HeadsUpText, WrapsAtNewlinesAndSpacesWithinTheWidth) {
     EXPECT_LE(line.size(), 77u);
   }
   EXPECT_TRUE(wrapText("", 10).empty());
+}
+
+// Issue 40, item 5: one row of the key table broke mid-entry ("7" / "midpoint"), `[` and `]`
+// said nothing until a drag, one point showed as "pull radius 0 m", and the |L| plot scaled
+// round-off (1e-15) to its full height.
+TEST(HeadsUpText, TheKeyTableKeepsEachEntryWholeAndThePullRadiusSaysWhatItIs) {
+  const auto integrators = allIntegrators();
+  for (std::size_t width = 40; width <= 110; width += 7) {
+    const std::vector<std::string> lines = wrapText(keyTable(), width, 20);
+    for (std::size_t i = 0; i < std::min<std::size_t>(integrators.size(), 10); ++i) {
+      std::string entry = std::to_string((i + 1) % 10);
+      entry.append(" ").append(integratorName(integrators[i]));
+      EXPECT_TRUE(
+          std::any_of(lines.begin(), lines.end(),
+                      [&](const std::string& l) { return l.find(entry) != std::string::npos; }))
+          << entry << " at width " << width;
+    }
+    for (std::size_t i = 1; i < lines.size(); ++i) {
+      EXPECT_LE(lines[i].size(), width);
+      // A continued row starts in the action column, not at the keys'.
+      if (lines[i].rfind("  ", 0) != 0) ADD_FAILURE() << "'" << lines[i] << "'";
+    }
+  }
+  ViewerState v;
+  EXPECT_EQ(handleKey(v, '[').command, Command::PullRadius);
+  EXPECT_EQ(handleKey(v, ']').command, Command::PullRadius);
+  EXPECT_EQ(pullRadiusText(0.0), "one point");
+  EXPECT_EQ(pullRadiusText(0.25), "0.25 m");
+  EXPECT_EQ(pullRadiusText(std::numeric_limits<double>::infinity()), "whole cube");
+
+  std::vector<float> noise;
+  for (int i = 0; i < 50; ++i) noise.push_back(1.0f + (i % 2 ? 1e-7f : -1e-7f) * 1e-8f);
+  const auto [lo, hi] = plotRange(noise, 1e-6);
+  EXPECT_GE(hi - lo, 0.9e-6f);  // drawn flat, not as a trend (floats round near 1)
+  const auto [lo2, hi2] = plotRange({0.0f, 2.0f}, 1e-6);
+  EXPECT_EQ(lo2, 0.0f);
+  EXPECT_EQ(hi2, 2.0f);  // a real change keeps its own range
 }
 
 TEST(FramePacing, StepsCoverTheFramesSimulatedTime) {

@@ -108,7 +108,7 @@ void drawOverlay(const Viewport& viewport, const ViewerState& view, const Overla
   }
   if (!overlay.help.empty()) {
     static constexpr float pale[3] = {0.85f, 0.9f, 1.0f};
-    const std::vector<std::string> lines = wrapText(overlay.help, width);
+    const std::vector<std::string> lines = wrapText(overlay.help, width, 20);
     const int top = std::min(viewport.height - 60, 30 + kLineHeight * int(lines.size()));
     drawTextBlock(viewport, lines, 16, top, pale, 1.0f);
   }

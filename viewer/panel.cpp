@@ -306,16 +306,36 @@ void Panel::solverOptions(const Frame& frame, SimRunner& runner) {
   }
 }
 
+std::pair<float, float> plotRange(const std::vector<float>& data, double relativeFloor) {
+  if (data.empty()) return {0.0f, 1.0f};
+  const auto [lo, hi] = std::minmax_element(data.begin(), data.end());
+  const double scale = std::max(std::abs(double(*lo)), std::abs(double(*hi)));
+  const double least = std::max(relativeFloor * scale, 1e-12);
+  const double mid = 0.5 * (double(*lo) + double(*hi));
+  const double half = 0.5 * std::max(double(*hi) - double(*lo), least);
+  return {float(mid - half), float(mid + half)};
+}
+
 void Panel::plots(const Frame& frame) {
   const auto plot = [&](int series, const char* overlay) {
     const auto& v = history_.values[series];
     if (v.empty()) return;
     std::vector<float> data(v.begin(), v.end());
-    const auto [lo, hi] = std::minmax_element(data.begin(), data.end());
     char label[96];
     std::snprintf(label, sizeof label, "%s %.4g", overlay, double(data.back()));
-    ImGui::PlotLines(PlotHistory::kNames[series], data.data(), int(data.size()), 0, label, *lo,
-                     *hi > *lo ? *hi : *lo + 1e-6f, ImVec2(130.0f, 32.0f));
+    // |L| as its relative change over the window: its round-off (1e-15) is no trend.
+    if (series == PlotHistory::AngularMomentum && std::abs(data.front()) > 0.0f) {
+      const double first = data.front();
+      for (float& x : data) x = float((double(x) - first) / first);
+      std::snprintf(label, sizeof label, "change %.2g", double(data.back()));
+    }
+    // A span below 1e-6 of the values (1e-6 absolute for a relative change) is drawn flat.
+    const bool relative = series == PlotHistory::AngularMomentum;
+    const auto [lo, hi] = relative ? plotRange(data, 0.0) : plotRange(data, 1e-6);
+    const auto [rlo, rhi] =
+        relative && hi - lo < 2e-6f ? std::pair(lo - 1e-6f, hi + 1e-6f) : std::pair(lo, hi);
+    ImGui::PlotLines(PlotHistory::kNames[series], data.data(), int(data.size()), 0, label, rlo, rhi,
+                     ImVec2(130.0f, 32.0f));
   };
   for (int s : {PlotHistory::Total, PlotHistory::Kinetic, PlotHistory::Spring, PlotHistory::Contact,
                 PlotHistory::Field, PlotHistory::AngularMomentum}) {
@@ -369,7 +389,13 @@ void Panel::build(const Frame& frame, ViewerState& view, SimRunner& runner) {
       runner.setSpeed(view.speed);
     }
     ImGui::Text("t %.3f s  %ld steps", frame.state.t, frame.steps);
-    ImGui::Text("%.3g simulated s per wall s%s", frame.simRate, frame.lagging ? " (behind)" : "");
+    if (frame.divergence) {
+      ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.3f, 1.0f), "diverged (r reloads)");
+    } else if (frame.paused) {
+      ImGui::Text("paused");
+    } else {
+      ImGui::Text("%.3g simulated s per wall s%s", frame.simRate, frame.lagging ? " (behind)" : "");
+    }
     if (ImGui::CollapsingHeader("solver")) solverOptions(frame, runner);
     if (ImGui::CollapsingHeader("world")) constants(frame, runner);
     if (ImGui::CollapsingHeader("pull")) {

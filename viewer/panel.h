@@ -8,6 +8,7 @@
 #include <deque>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "viewer/sim_runner.h"
@@ -15,13 +16,17 @@
 
 namespace jello::viewer {
 
+// The vertical range a plot of `data` is drawn over: its own, widened to at least relativeFloor
+// times its largest magnitude (1e-12 at least), so that round-off does not fill the plot.
+std::pair<float, float> plotRange(const std::vector<float>& data, double relativeFloor);
+
 // The plotted quantities over a sliding window of simulated time, one sample per new frame.
 struct PlotHistory {
   static constexpr double kWindow = 10.0;  // wall seconds kept
   enum Series { Kinetic, Spring, Contact, Field, Total, AngularMomentum, Effort, StepSize, kCount };
   static constexpr std::array<const char*, kCount> kNames{
       "kinetic (J)", "spring (J)",     "contact (J)",          "field (J)",
-      "total (J)",   "|L| (kg m^2/s)", "solver effort / step", "CVODE step (s)"};
+      "total (J)",   "|L| (relative)", "solver effort / step", "CVODE step (s)"};
   std::deque<double> wall;
   std::array<std::deque<float>, kCount> values;
   std::string effortName;  // which counter the effort is of ("newton_iterations", ...)

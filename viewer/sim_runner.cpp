@@ -218,10 +218,16 @@ void SimRunner::publish(std::unique_lock<std::mutex>& lock) {
   f.generation = generation_;
   f.speed = speed_;
   f.paused = paused_;
+  // Time that went back (a reload, an edit of the state) starts the measure over: measured
+  // across it, the rate read "-60.8 s per wall second".
+  if (!rate_.empty() && (f.state.t < rate_.back().second || f.generation != latest_.generation)) {
+    rate_.clear();
+  }
   rate_.emplace_back(wall, f.state.t);
   while (rate_.size() > 2 && rate_[1].first <= wall - kRateWindow) rate_.pop_front();
   const double span = wall - rate_.front().first;
-  f.simRate = span > 0.0 ? (f.state.t - rate_.front().second) / span : latest_.simRate;
+  f.rateSpan = span;
+  f.simRate = span > 0.0 ? (f.state.t - rate_.front().second) / span : 0.0;
   f.lagging = wall - lastDrop_ < 1.0;
   latest_ = std::move(f);
   lastPublish_ = wall;

@@ -58,8 +58,9 @@ struct Frame {
   std::optional<std::pair<int, Vec3>> pull;  // picked point and target while pulling
   double speed = 1.0;
   bool paused = false;
-  double simRate = 0.0;  // simulated seconds per wall second over the last half second
-  bool lagging = false;  // simulated time was dropped in the last second
+  double simRate = 0.0;   // simulated seconds per wall second over the last half second
+  double rateSpan = 0.0;  // wall seconds that rate covers (0 right after a reload)
+  bool lagging = false;   // simulated time was dropped in the last second
 };
 
 struct Notice {

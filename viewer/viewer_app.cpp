@@ -31,9 +31,16 @@ std::string Viewer::hudLine(std::size_t pane) const {
   } else {
     os << "speed " << format("%.4g", f.speed) << "x";
   }
-  os << "  " << format("%.0f", fps_) << " fps  E " << format("%.4g", f.energy.total()) << " J";
+  // A recording's frames are not drawn in real time: its progress, not a frame rate ("0 fps").
+  if (recording()) {
+    os << "  frame " << framesDrawn_ + 1 << "/" << options_.frames;
+  } else {
+    os << "  " << format("%.0f", fps_) << " fps";
+  }
+  os << "  E " << format("%.4g", f.energy.total()) << " J";
   const bool behind = f.lagging && !f.paused && !f.divergence;
-  const bool slow = !options_.courseTime && !recording() && !f.paused &&
+  // Judged over a quarter second at least: right after a reload there is no rate yet.
+  const bool slow = !options_.courseTime && !recording() && !f.paused && f.rateSpan >= 0.25 &&
                     f.simRate < 0.9 * f.speed && !f.divergence;
   if (behind || slow) {
     os << "\nbehind: simulating " << format("%.3g", f.simRate) << " s per wall second (speed asks "
@@ -43,8 +50,7 @@ std::string Viewer::hudLine(std::size_t pane) const {
   if (view_.paused || view_.pullMode || drag_ == Drag::Pull) os << '\n';
   if (view_.paused) os << "[paused]  ";
   if (view_.pullMode || drag_ == Drag::Pull) {
-    const double r = pullRadius();
-    os << "pull radius " << (std::isinf(r) ? std::string("whole cube") : format("%.2g m", r));
+    os << "pull radius " << pullRadiusText(pullRadius());
   }
   return os.str();
 }
@@ -53,16 +59,18 @@ Overlay Viewer::overlay(std::size_t pane) const {
   Overlay o;
   o.hud = hudLine(pane);
   if (view_.showHelp && pane == 0) o.help = "Keys and mouse (? closes):\n" + keyTable();
+  const double age = seconds(Clock::now() - messageTime_);
+  const double life = alarm_ ? kAlarmSeconds : kNoticeSeconds;
   if (frames_[pane].divergence) {  // stays until the scene is restarted
     o.message = *frames_[pane].divergence + restartHint();
+    // A key pressed meanwhile is answered too (an integrator key said nothing after this).
+    if (pane == 0 && !message_.empty() && age < life) o.message = message_ + "\n" + o.message;
     o.alarm = true;
     return o;
   }
   if (pane > 0) return o;
   o.message = message_;
   o.alarm = alarm_;
-  const double age = seconds(Clock::now() - messageTime_);
-  const double life = alarm_ ? kAlarmSeconds : kNoticeSeconds;
   o.messageAlpha =
       static_cast<float>(std::clamp((life + kFadeSeconds - age) / kFadeSeconds, 0.0, 1.0));
   return o;

@@ -67,6 +67,9 @@ void Viewer::key(unsigned char key) {
       postAll([scale = view_.dtScale](ViewerSession& s) { s.scaleTimeStep(scale); }, true);
       notify("time step x" + format("%.4g", view_.dtScale) + " of the world's", false);
       break;
+    case Command::PullRadius:
+      notify("pull radius " + pullRadiusText(pullRadius()), false);
+      break;
     case Command::StepOnce:
       if (view_.paused && group_) group_->advanceBy(primary().geometry->frameTime);
       if (view_.paused && !group_) runner().stepFrame();

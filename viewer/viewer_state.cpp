@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <vector>
 
@@ -79,10 +80,10 @@ KeyResult handleKey(ViewerState& s, unsigned char key) {
       break;
     case '[':
       s.pullRadius = std::max(0, s.pullRadius - 1);
-      break;
+      return {Command::PullRadius, {}};
     case ']':
       s.pullRadius = std::min(int(pullRadii().size()) - 1, s.pullRadius + 1);
-      break;
+      return {Command::PullRadius, {}};
     case '+':
     case '=':
       s.dtScale *= 2.0;
@@ -161,20 +162,44 @@ std::string keyTable() {
   return os.str();
 }
 
-std::vector<std::string> wrapText(const std::string& text, std::size_t width) {
+std::vector<std::string> wrapText(const std::string& text, std::size_t width, std::size_t hanging) {
   std::vector<std::string> lines;
+  hanging = std::min(hanging, width / 2);
   std::size_t start = 0;
+  bool continued = false;  // this line goes on from the one before
   while (start < text.size()) {
+    const std::size_t room = continued ? width - hanging : width;
     std::size_t end = text.find('\n', start);
     if (end == std::string::npos) end = text.size();
-    if (end - start > width) {
-      const std::size_t space = text.rfind(' ', start + width);
-      end = space != std::string::npos && space > start ? space : start + width;
+    if (end - start > room) {
+      std::size_t space = text.rfind(' ', start + room);
+      // Never after a lone number: "7 midpoint" is one entry of the key table.
+      while (space != std::string::npos && space > start) {
+        const std::size_t word = text.rfind(' ', space - 1);
+        const std::size_t from = word == std::string::npos || word < start ? start : word + 1;
+        const std::string token = text.substr(from, space - from);
+        const bool number =
+            !token.empty() && token.size() <= 2 &&
+            std::all_of(token.begin(), token.end(), [](char c) { return c >= '0' && c <= '9'; });
+        if (!number || from == start) break;
+        space = from - 1;
+      }
+      end = space != std::string::npos && space > start ? space : start + room;
     }
-    lines.push_back(text.substr(start, end - start));
+    lines.push_back((continued ? std::string(hanging, ' ') : std::string()) +
+                    text.substr(start, end - start));
+    continued = end < text.size() && text[end] != '\n';
     start = end < text.size() && (text[end] == '\n' || text[end] == ' ') ? end + 1 : end;
   }
   return lines;
+}
+
+std::string pullRadiusText(double radius) {
+  if (radius == 0.0) return "one point";
+  if (std::isinf(radius)) return "whole cube";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2g m", radius);
+  return text;
 }
 
 int stepsPerFrame(double frameTime, double dt) {

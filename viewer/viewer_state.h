@@ -46,6 +46,7 @@ enum class Command {
   Pause,             // p: paused changed
   Speed,             // < >: speed changed
   SaveWorld,         // w: save the current state as a world file
+  PullRadius,        // [ ]: pullRadius changed (said on screen at once)
 };
 
 struct KeyResult {
@@ -69,7 +70,11 @@ std::string keyTable();  // "  keys  action" lines
 
 // The heads-up text as lines of at most `width` characters, broken at '\n' and, when too
 // long, at the last space that fits (or hard, when there is none).
-std::vector<std::string> wrapText(const std::string& text, std::size_t width);
+// Lines continuing an over-long one start with `hanging` spaces (the key table's action column).
+std::vector<std::string> wrapText(const std::string& text, std::size_t width,
+                                  std::size_t hanging = 0);
+// A pull radius as the heads-up and the notices say it: "one point", "0.25 m", "whole cube".
+std::string pullRadiusText(double radius);
 
 // Course time: simulated seconds to advance per displayed frame, split into whole steps of at
 // most dt: the frame time is the world's n*dt0 (fixed when +/- change dt), at least one step.
