@@ -216,6 +216,37 @@ TEST(Recording, CompareModeDrawsEachIntegratorInItsOwnPane) {
   EXPECT_LT(gutter.r + gutter.g + gutter.b, 3 * 30);
 }
 
+// Issue 40, item 2: at 640x480 each compare pane's heads-up wrapped to five lines and covered a
+// third of the pane. It is one compact line now (the first pane adds one for the group's pace):
+// against the same frame without heads-up, the second and third panes differ in their top 18
+// rows (the line) and not at all below row 24.
+TEST(Recording, EachComparePaneHasOneCompactHeadsUpLine) {
+  test::TempDir dir;
+  const std::string panes = " --compare rk4,implicit,energy-momentum --frames 1 --record ";
+  ASSERT_EQ(run(headless(world("jello.w") + panes + (dir.path() / "hud").string())).code, 0);
+  ASSERT_EQ(
+      run(headless(world("jello.w") + " --no-hud" + panes + (dir.path() / "bare").string())).code,
+      0);
+  const Image hud = readImage(dir.path() / "hud" / "000.jpg");
+  const Image bare = readImage(dir.path() / "bare" / "000.jpg");
+  const auto difference = [&](int x0, int x1, int y0, int y1) {
+    double sum = 0.0;
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) {
+        const Rgb a = pixel(hud, x, y), b = pixel(bare, x, y);
+        sum += std::abs(a.r - b.r) + std::abs(a.g - b.g) + std::abs(a.b - b.b);
+      }
+    }
+    return sum / (3.0 * (x1 - x0) * (y1 - y0));
+  };
+  for (int pane = 1; pane < 3; ++pane) {
+    const int x0 = pane * 640 / 3 + 2, x1 = x0 + 150;
+    EXPECT_GT(difference(x0, x1, 2, 18), 5.0) << "pane " << pane << ": no heads-up line";
+    EXPECT_LT(difference(x0, x1, 24, 80), 1.0) << "pane " << pane << ": more than one line";
+  }
+  EXPECT_GT(difference(2, 150, 20, 30), 5.0) << "the first pane's second line";
+}
+
 // The cone and the spiral are drawn where they are: lit surface colour at the projection of a
 // point on each surface facing the camera (the cube far away behind them, out of the way).
 TEST(Recording, TheConeAndTheSpiralAreDrawnWhereTheyAre) {

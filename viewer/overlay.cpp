@@ -17,9 +17,22 @@ namespace {
 // The drawn pane's lower-left corner in the window (glWindowPos is in window coordinates).
 int paneX = 0, paneY = 0;  // set by setOverlayOrigin
 
-void drawText(int x, int y, const std::string& text) {
+// The fixed 8x13 font, or the small proportional one of the compare panes' heads-up.
+struct Font {
+  void* glut;
+  int lineHeight;
+  int charWidth;  // for wrapping: the widest a character usually is
+};
+const Font kFixed{GLUT_BITMAP_8_BY_13, 16, 8};
+const Font kSmall{GLUT_BITMAP_HELVETICA_10, 12, 6};
+
+void drawText(int x, int y, const std::string& text, const Font& font = kFixed) {
   glWindowPos2i(paneX + x, paneY + y);
-  glutBitmapString(GLUT_BITMAP_8_BY_13, reinterpret_cast<const unsigned char*>(text.c_str()));
+  glutBitmapString(font.glut, reinterpret_cast<const unsigned char*>(text.c_str()));
+}
+
+int textWidth(const std::string& text, const Font& font) {
+  return glutBitmapLength(font.glut, reinterpret_cast<const unsigned char*>(text.c_str()));
 }
 
 constexpr int kLineHeight = 16, kCharWidth = 8;
@@ -45,22 +58,22 @@ void endPixels() {
 // Lines of text on a translucent dark backing; `top` is the first line's baseline, from the
 // window's bottom (GL's window coordinates).
 void drawTextBlock(const Viewport& viewport, const std::vector<std::string>& lines, int x, int top,
-                   const float colour[3], float alpha) {
+                   const float colour[3], float alpha, const Font& font = kFixed) {
   if (lines.empty()) return;
-  std::size_t longest = 0;
-  for (const std::string& line : lines) longest = std::max(longest, line.size());
-  const int w = static_cast<int>(longest) * kCharWidth + 8;
-  const int h = static_cast<int>(lines.size()) * kLineHeight + 4;
+  int longest = 0;
+  for (const std::string& line : lines) longest = std::max(longest, textWidth(line, font));
+  const int w = longest + 8;
+  const int h = static_cast<int>(lines.size()) * font.lineHeight + 4;
   beginPixels(viewport);
   glEnable(GL_BLEND);
   glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   glColor4f(0.0f, 0.0f, 0.0f, 0.6f * alpha);
-  glRectd(x - 4, top + kLineHeight - 3, x - 4 + w, top + kLineHeight - 3 - h);
+  glRectd(x - 4, top + font.lineHeight - 3, x - 4 + w, top + font.lineHeight - 3 - h);
   glColor4f(colour[0], colour[1], colour[2], alpha);
   int y = top;
   for (const std::string& line : lines) {
-    drawText(x, y, line);
-    y -= kLineHeight;
+    drawText(x, y, line, font);
+    y -= font.lineHeight;
   }
   glDisable(GL_BLEND);
   endPixels();
@@ -104,7 +117,22 @@ void drawOverlay(const Viewport& viewport, const ViewerState& view, const Overla
   const std::size_t width = static_cast<std::size_t>(std::max(8, viewport.width / kCharWidth - 2));
   if (view.showHud && !overlay.hud.empty()) {
     static constexpr float white[3] = {0.92f, 0.92f, 0.92f};
-    drawTextBlock(viewport, wrapText(overlay.hud, width), 8, viewport.height - 18, white, 1.0f);
+    const Font& font = overlay.compactHud ? kSmall : kFixed;
+    std::size_t chars = static_cast<std::size_t>(std::max(8, viewport.width / font.charWidth - 2));
+    if (overlay.compactHud) {
+      // A proportional font: as many characters as this text's own average width lets fit (all
+      // of it when its widest line fits).
+      const int measured = textWidth(overlay.hud, font);
+      if (measured <= viewport.width - 12) {
+        chars = overlay.hud.size();
+      } else if (measured > 0) {
+        chars = std::max<std::size_t>(
+            8, static_cast<std::size_t>(double(viewport.width - 12) * double(overlay.hud.size()) /
+                                        double(measured)));
+      }
+    }
+    drawTextBlock(viewport, wrapText(overlay.hud, chars), 8, viewport.height - 6 - font.lineHeight,
+                  white, 1.0f, font);
   }
   if (!overlay.help.empty()) {
     static constexpr float pale[3] = {0.85f, 0.9f, 1.0f};

@@ -39,6 +39,7 @@ struct Overlay {
   bool alarm = false;         // the message is an error (red) rather than a notice
   float messageAlpha = 1.0f;  // fades out
   std::string help;           // drawn in the middle when not empty (the key table)
+  bool compactHud = false;    // the heads-up in a small proportional font (compare panes)
 };
 
 // Once, after the window exists: depth test, lights, materials.

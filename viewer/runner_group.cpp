@@ -16,7 +16,17 @@ RunnerGroup::RunnerGroup(const SceneSource& source, const World& world,
     s.integrator = kind;
     runners_.push_back(std::make_unique<SimRunner>(s, world, options));
   }
-  target_ = runners_.empty() ? 0.0 : runners_.front()->frame().state.t;
+  target_ = shown_ = runners_.empty() ? 0.0 : runners_.front()->frame().state.t;
+}
+
+double RunnerGroup::rate() const {
+  if (shownAt_.size() < 2) return 0.0;
+  const double span = shownAt_.back().first - shownAt_.front().first;
+  return span > 0.0 ? (shownAt_.back().second - shownAt_.front().second) / span : 0.0;
+}
+
+double RunnerGroup::rateSpan() const {
+  return shownAt_.size() < 2 ? 0.0 : shownAt_.back().first - shownAt_.front().first;
 }
 
 bool RunnerGroup::allReached() const {
@@ -38,6 +48,9 @@ void RunnerGroup::tick(double wall) {
   }
   if (lastWall_ < 0.0) lastWall_ = wall;
   if (!allReached()) return;
+  shown_ = target_;
+  shownAt_.emplace_back(wall, shown_);
+  while (shownAt_.size() > 2 && shownAt_[1].first <= wall - 0.5) shownAt_.pop_front();
   const double elapsed = std::min(wall - lastWall_, kMaxBacklog);
   lastWall_ = wall;
   if (elapsed <= 0.0) return;
@@ -51,12 +64,14 @@ void RunnerGroup::setPaused(bool paused) {
 }
 
 void RunnerGroup::advanceBy(double span) {
+  if (allReached()) shown_ = target_;
   target_ += span;
   setTargetAll();
 }
 
 void RunnerGroup::setTarget(double t) {
-  target_ = t;
+  if (t < shown_) shownAt_.clear();  // a reload: time starts over
+  target_ = shown_ = t;
   lastWall_ = -1.0;
   setTargetAll();
 }

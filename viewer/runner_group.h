@@ -4,6 +4,7 @@
 // that diverged stops and no longer holds the others back.
 #pragma once
 
+#include <deque>
 #include <memory>
 #include <vector>
 
@@ -30,6 +31,13 @@ class RunnerGroup {
   // One shared step of `span` simulated seconds (recording, `.` while paused, course time).
   void advanceBy(double span);
   double target() const { return target_; }
+  // The target every running member has reached: the instant all panes show
+  // (SimRunner::frameAt), while the faster ones may already be at target().
+  double shown() const { return shown_; }
+  // Simulated seconds per wall second of the shown instant over the last half second, and the
+  // wall seconds that covers (0 at the start and after a reload): the slowest member's pace.
+  double rate() const;
+  double rateSpan() const;
   // True when every member that has not diverged shows the target time (to one step).
   bool allReached() const;
   // Sets the shared target (recording; after a reload, time starts over).
@@ -42,7 +50,9 @@ class RunnerGroup {
   double speed_ = 1.0;
   bool paused_ = false;
   double target_ = 0.0;
+  double shown_ = 0.0;
   double lastWall_ = -1.0;
+  std::deque<std::pair<double, double>> shownAt_;  // (wall, shown) when shown moved
 };
 
 }  // namespace jello::viewer

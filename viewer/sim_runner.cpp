@@ -90,6 +90,14 @@ Frame SimRunner::frame() const {
   return latest_;
 }
 
+std::optional<Frame> SimRunner::frameAt(double target) const {
+  std::lock_guard lock(mutex_);
+  for (auto at = reachedFrames_.rbegin(); at != reachedFrames_.rend(); ++at) {
+    if (at->first == target) return at->second;
+  }
+  return std::nullopt;
+}
+
 std::vector<Notice> SimRunner::takeNotices() {
   std::lock_guard lock(mutex_);
   return std::exchange(notices_, {});
@@ -222,6 +230,7 @@ void SimRunner::publish(std::unique_lock<std::mutex>& lock) {
   // across it, the rate read "-60.8 s per wall second".
   if (!rate_.empty() && (f.state.t < rate_.back().second || f.generation != latest_.generation)) {
     rate_.clear();
+    reachedFrames_.clear();
   }
   rate_.emplace_back(wall, f.state.t);
   while (rate_.size() > 2 && rate_[1].first <= wall - kRateWindow) rate_.pop_front();
@@ -230,6 +239,15 @@ void SimRunner::publish(std::unique_lock<std::mutex>& lock) {
   f.simRate = span > 0.0 ? (f.state.t - rate_.front().second) / span : 0.0;
   f.lagging = wall - lastDrop_ < 1.0;
   latest_ = std::move(f);
+  if (options_.pacing == Pacing::Target && latest_.state.t >= target_ - 1e-12) {
+    // Reached: kept under its target (replaced while it stays, a pull edits the state).
+    if (!reachedFrames_.empty() && reachedFrames_.back().first == target_) {
+      reachedFrames_.back().second = latest_;
+    } else {
+      reachedFrames_.emplace_back(target_, latest_);
+      if (reachedFrames_.size() > 4) reachedFrames_.pop_front();
+    }
+  }
   lastPublish_ = wall;
   ++published_;
   reached_.notify_all();

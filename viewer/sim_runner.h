@@ -89,6 +89,9 @@ class SimRunner {
 
   // The latest published frame (a copy; never waits for a step).
   Frame frame() const;
+  // Target pacing: the frame published when the simulation reached `target` (the last few
+  // targets are kept), or nothing. Compare mode draws every pane at the target all reached.
+  std::optional<Frame> frameAt(double target) const;
   // Messages from the simulation thread (divergence, reload results) since the last call.
   std::vector<Notice> takeNotices();
   // Adds a message; commands call it from the simulation thread. A command that throws adds
@@ -137,9 +140,10 @@ class SimRunner {
   double speed_ = 1.0;
   // Real time: simulated time baseSim_ at wall time baseWall_; Target pacing: target_.
   double baseSim_ = 0.0, baseWall_ = 0.0, target_ = 0.0;
-  double frameTarget_ = -1e300;                 // paused: the time `.` asked for
-  double lastDrop_ = -1e300;                    // wall time simulated time was last dropped
-  std::deque<std::pair<double, double>> rate_;  // (wall, simulated) at publishes
+  double frameTarget_ = -1e300;                         // paused: the time `.` asked for
+  double lastDrop_ = -1e300;                            // wall time simulated time was last dropped
+  std::deque<std::pair<double, double>> rate_;          // (wall, simulated) at publishes
+  std::deque<std::pair<double, Frame>> reachedFrames_;  // Target pacing: (target, its frame)
   double lastPublish_ = -1e300;
 
   std::thread thread_;

@@ -24,6 +24,34 @@ std::string Viewer::restartHint() const {
 std::string Viewer::hudLine(std::size_t pane) const {
   const Frame& f = frames_[pane];
   std::ostringstream os;
+  if (group_) {
+    // One compact line a pane (five wrapped lines covered a third of a 640x480 pane); the
+    // group's pace on the first pane's second line.
+    // A step the panes share is said once, on the first pane's second line.
+    const bool shared = std::all_of(frames_.begin(), frames_.end(),
+                                    [&](const Frame& other) { return other.dt == f.dt; });
+    os << integratorName(f.integrator);
+    if (!shared) os << " dt " << format("%.2g", f.dt * 1e3) << " ms";
+    os << " t " << format("%.3f", f.state.t) << " E " << format("%.3g", f.energy.total()) << " J";
+    if (pane > 0) return os.str();
+    os << "\n";
+    if (shared) os << "dt " << format("%.2g", f.dt * 1e3) << " ms  ";
+    os << (options_.courseTime ? std::string("course time")
+                               : "speed " + format("%.4g", f.speed) + "x");
+    if (recording()) {
+      os << "  frame " << framesDrawn_ + 1 << "/" << options_.frames;
+    } else {
+      os << "  " << format("%.0f", fps_) << " fps";
+      if (!view_.paused && !options_.courseTime && group_->rateSpan() >= 0.25 &&
+          group_->rate() < 0.9 * f.speed) {
+        os << "  behind: " << format("%.3g", group_->rate()) << " s per wall s";
+      }
+    }
+    if (view_.paused) os << "  [paused]";
+    if (view_.pullMode || drag_ == Drag::Pull)
+      os << "  pull radius " << pullRadiusText(pullRadius());
+    return os.str();
+  }
   os << integratorName(f.integrator) << "  dt " << format("%.3g", f.dt) << " s  t "
      << format("%.3f", f.state.t) << " s  ";
   if (options_.courseTime) {
@@ -58,6 +86,7 @@ std::string Viewer::hudLine(std::size_t pane) const {
 Overlay Viewer::overlay(std::size_t pane) const {
   Overlay o;
   o.hud = hudLine(pane);
+  o.compactHud = group_ != nullptr;
   if (view_.showHelp && pane == 0) o.help = "Keys and mouse (? closes):\n" + keyTable();
   const double age = seconds(Clock::now() - messageTime_);
   const double life = alarm_ ? kAlarmSeconds : kNoticeSeconds;
@@ -174,7 +203,13 @@ void Viewer::display() {
       group_->tick(seconds(Clock::now() - started_));
     }
   }
-  for (std::size_t i = 0; i < frames_.size(); ++i) frames_[i] = runner(i).frame();
+  // Compare mode: every pane at the instant all reached (the faster ones may be ahead), so the
+  // panes show one simulated time; a recording waited for all to reach its frame's time.
+  for (std::size_t i = 0; i < frames_.size(); ++i) {
+    std::optional<Frame> at;
+    if (group_ && !recording()) at = runner(i).frameAt(group_->shown());
+    frames_[i] = at ? std::move(*at) : runner(i).frame();
+  }
   if (const long published = runner().published(); published != drawnPublished_) {
     drawnPublished_ = published;
     panel_.sample(seconds(Clock::now() - started_), primary());
