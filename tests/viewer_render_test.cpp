@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "src/effects/contact.h"
 #include "src/state.h"
 #include "src/world/world_writer.h"
 #include "tests/test_support.h"
@@ -245,6 +246,35 @@ TEST(Recording, EachComparePaneHasOneCompactHeadsUpLine) {
     EXPECT_LT(difference(x0, x1, 24, 80), 1.0) << "pane " << pane << ": more than one line";
   }
   EXPECT_GT(difference(2, 150, 20, 30), 5.0) << "the first pane's second line";
+}
+
+// Issue 40, item 3: depth you can see. The floor is solid (the floor colour where it shows),
+// and the cube casts a shadow on it along the key light: the floor point under the cube's centre
+// along the light is darker than the floor elsewhere, and not the cube's red (it shows). The
+// camera cannot orbit below the floor.
+TEST_F(Frames, TheFloorIsSolidAndTheCubeCastsAShadowOnIt) {
+  const Image image = frame("shaded");
+  const State s = initialState(test::loadWorld("jello.w"));
+  Vec3 c;
+  for (int p = 0; p < s.numPoints(); ++p) c += s.position(p) * (1.0 / s.numPoints());
+  const Vec3 light{0.4, 0.5, 1.0};  // the renderer's key light, towards it
+  const Vec3 shadow = c - light * ((c.z + kBoxHalfSize) / light.z);
+  const auto under = project(Camera{}, Viewport{640, 480}, shadow);
+  const auto away = project(Camera{}, Viewport{640, 480}, Vec3{1.7, -1.7, -kBoxHalfSize});
+  ASSERT_TRUE(under.has_value() && away.has_value());
+  const Rgb dark = pixel(image, int(under->x), int(under->y));
+  const Rgb floor = pixel(image, int(away->x), int(away->y));
+  EXPECT_NEAR(floor.b, int(kFloor[2] * 255), 12) << "the floor is solid";
+  // (jello.w's translucent plane lies over part of it: 0.85, not the shadow's own 0.55.)
+  EXPECT_LT(dark.r + dark.g + dark.b, 0.85 * (floor.r + floor.g + floor.b)) << "no shadow";
+  EXPECT_LT(dark.r, 2 * dark.g + 20) << "the cube, not its shadow, is there";
+
+  Camera camera;
+  for (int i = 0; i < 200; ++i) camera.rotate(0.0, -30.0);  // dragging down as far as it goes
+  EXPECT_GE(camera.eye().z, camera.minEyeZ - 1e-12);
+  camera.zoomBy(5.0);
+  camera.pan(0.0, 400.0, 480);
+  EXPECT_GE(camera.eye().z, camera.minEyeZ - 1e-12);
 }
 
 // The cone and the spiral are drawn where they are: lit surface colour at the projection of a

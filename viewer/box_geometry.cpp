@@ -7,6 +7,11 @@
 
 namespace jello::viewer {
 
+std::vector<Vec3> floorCorners() {
+  const double h = kBoxHalfSize;
+  return {{-h, -h, -h}, {h, -h, -h}, {h, h, -h}, {-h, h, -h}};
+}
+
 std::array<std::pair<Vec3, Vec3>, 12> boxEdges() {
   const double h = kBoxHalfSize;
   std::array<std::pair<Vec3, Vec3>, 12> edges;

@@ -14,6 +14,8 @@ namespace jello::viewer {
 
 // The box's 12 edges, as (start, end) pairs.
 std::array<std::pair<Vec3, Vec3>, 12> boxEdges();
+// The box's floor (z = -2), its corners counter-clockwise seen from above.
+std::vector<Vec3> floorCorners();
 
 // The plane's part inside the box, corners in counter-clockwise order seen from the free side
 // (where a x + b y + c z + d > 0); empty when the plane misses the box.

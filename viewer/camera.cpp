@@ -38,19 +38,31 @@ void Camera::rotate(double dxPixels, double dyPixels) {
   phi += 0.01 * dxPixels;
   const double limit = std::numbers::pi / 2 - 0.01;  // z-up stays defined
   theta = std::clamp(theta + 0.01 * dyPixels, -limit, limit);
+  keepAboveFloor();
 }
 
 void Camera::zoom(double metres) {
   radius = std::max(0.5, radius + metres);
+  keepAboveFloor();
 }
 
 void Camera::zoomBy(double factor) {
   radius = std::clamp(radius * factor, 0.5, 100.0);
+  keepAboveFloor();
 }
 
 void Camera::pan(double dxPixels, double dyPixels, int viewportHeight) {
   const double metresPerPixel = 2.0 * radius * tanHalfFov(*this) / std::max(viewportHeight, 1);
   center = center - (right() * dxPixels - up() * dyPixels) * metresPerPixel;
+  center.z = std::max(center.z, minEyeZ);  // the point looked at stays above the floor too
+  keepAboveFloor();
+}
+
+void Camera::keepAboveFloor() {
+  if (eye().z >= minEyeZ) return;
+  const double limit = std::numbers::pi / 2 - 0.01;
+  theta =
+      std::clamp(std::asin(std::clamp((minEyeZ - center.z) / radius, -1.0, 1.0)), -limit, limit);
 }
 
 Eigen::Matrix4d viewMatrix(const Camera& c) {

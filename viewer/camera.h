@@ -22,6 +22,9 @@ struct Camera {
   Vec3 center{};                        // m, the point looked at (middle-drag pans it)
   double fovY = 60.0;                   // degrees, vertical field of view
   double zNear = 0.01, zFar = 1000.0;   // m
+  // m: the eye stays above this height (the box's solid floor is at z = -2): rotating, zooming
+  // and panning cannot take it below the floor.
+  double minEyeZ = -1.9;
 
   Vec3 eye() const;
   // Unit vectors of the view: forward (eye to origin), right and up on the screen.
@@ -38,6 +41,8 @@ struct Camera {
   // Middle-drag: moves the centre so that the scene follows the cursor (at the centre's depth)
   // in a window `viewportHeight` pixels high.
   void pan(double dxPixels, double dyPixels, int viewportHeight);
+  // Raises the elevation just enough that the eye is at minEyeZ or above (the others call it).
+  void keepAboveFloor();
 };
 
 struct Viewport {

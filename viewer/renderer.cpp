@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <numbers>
 
 // glWindowPos (GL 1.4) is declared only with the extension prototypes.
@@ -23,6 +24,15 @@ void vertex(const Vec3& p) {
 
 void drawBox() {
   const double h = kBoxHalfSize;
+  // A solid floor (the grid was see-through: nothing said where the cube stood), pushed back in
+  // depth so that its grid lines and the shadows on it win.
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  glPolygonOffset(1.0f, 1.0f);
+  glColor3fv(kFloor);
+  glBegin(GL_QUADS);
+  for (const Vec3& corner : floorCorners()) vertex(corner);
+  glEnd();
+  glDisable(GL_POLYGON_OFFSET_FILL);
   glColor3f(0.75f, 0.75f, 0.8f);
   glBegin(GL_LINES);
   for (const auto& [a, b] : boxEdges()) {
@@ -37,6 +47,63 @@ void drawBox() {
     glVertex3d(c, h, -h);
     glVertex3d(-h, c, -h);
     glVertex3d(h, c, -h);
+  }
+  glEnd();
+}
+
+// The light the shadows fall from: the key light's direction (towards it), as drawFrame sets it.
+constexpr double kShadowLight[3] = {0.4, 0.5, 1.0};
+
+// Flattens geometry onto the plane a x + b y + c z + d = 0 along the light's direction: the
+// classic planar projection (P . L) I - L P^T, with L = (light, 0) a direction.
+Eigen::Matrix4d shadowMatrix(const Eigen::Vector4d& plane) {
+  const Eigen::Vector4d light(kShadowLight[0], kShadowLight[1], kShadowLight[2], 0.0);
+  return plane.dot(light) * Eigen::Matrix4d::Identity() - light * plane.transpose();
+}
+
+// The shadow of `casters` on the receiver plane, inside its `polygon`: the casters flattened onto
+// it mark the stencil (no colour, no depth), then the polygon is darkened where marked, once
+// however many casters overlap. Drawn with the depth test, so the shadow is hidden where
+// something stands in front of the receiver.
+void drawShadow(const Eigen::Vector4d& receiver, const std::vector<Vec3>& polygon,
+                const std::function<void()>& casters) {
+  const Eigen::Vector4d light(kShadowLight[0], kShadowLight[1], kShadowLight[2], 0.0);
+  // A receiver facing away from the light, or edge-on, is not lit: no shadow to draw.
+  if (polygon.empty() || receiver.dot(light) <= 1e-6 * receiver.head<3>().norm()) return;
+  glClear(GL_STENCIL_BUFFER_BIT);
+  glEnable(GL_STENCIL_TEST);
+  glStencilFunc(GL_ALWAYS, 1, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  glDepthMask(GL_FALSE);
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  glPolygonOffset(-1.0f, -4.0f);
+  glPushMatrix();
+  const Eigen::Matrix4d flatten = shadowMatrix(receiver);
+  glMultMatrixd(flatten.data());
+  casters();
+  glPopMatrix();
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  glStencilFunc(GL_EQUAL, 1, 0xff);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_ZERO);  // each pixel darkened once
+  glDisable(GL_LIGHTING);
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  glColor4f(0.0f, 0.0f, 0.0f, 0.45f);
+  glBegin(GL_POLYGON);
+  for (const Vec3& p : polygon) vertex(p);
+  glEnd();
+  glDisable(GL_BLEND);
+  glDisable(GL_POLYGON_OFFSET_FILL);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_STENCIL_TEST);
+}
+
+// The cube's triangles, positions only: what a shadow is cast by.
+void drawCubeSilhouette(const Scene& scene) {
+  glBegin(GL_TRIANGLES);
+  for (const auto& t : scene.mesh->triangles) {
+    for (int c = 0; c < 3; ++c) vertex(scene.state->position(t[c]));
   }
   glEnd();
 }
@@ -376,6 +443,14 @@ void drawFrame(const ViewerState& view, const Viewport& viewport, const Scene& s
   glLightfv(GL_LIGHT1, GL_POSITION, fillDirection);
 
   drawBox();
+  // Shadows on the floor, of the cube and the solids, so a user sees where the cube is and
+  // whether it touches.
+  drawShadow({0.0, 0.0, 1.0, kBoxHalfSize}, floorCorners(), [&] {
+    drawCubeSilhouette(scene);
+    if (scene.world->sphere) drawSphere(*scene.world->sphere);
+    if (scene.world->cone) drawCone(*scene.world->cone);
+    if (scene.world->spiral) drawSpiral(*scene.world->spiral);
+  });
   if (view.mode == DisplayMode::Shaded) {
     drawShadedCube(scene);
   } else {
@@ -391,7 +466,12 @@ void drawFrame(const ViewerState& view, const Viewport& viewport, const Scene& s
   }
   if (scene.pull) drawPull(view, scene);
   if (scene.push) drawPush(view, scene);
-  if (scene.world->plane) drawPlane(*scene.world->plane);  // blended: last
+  if (scene.world->plane) {
+    drawPlane(*scene.world->plane);  // blended: last
+    // The cube's shadow on the plane (what lies under the plane is in its solid).
+    const Plane& p = *scene.world->plane;
+    drawShadow({p.a, p.b, p.c, p.d}, planeInBox(p), [&] { drawCubeSilhouette(scene); });
+  }
   drawOverlay(viewport, view, overlay);
   if (view.showField && scene.arrows && !scene.arrows->empty()) {
     double strongest = 0.0;

@@ -19,6 +19,7 @@ namespace jello::viewer {
 
 // The background colour: tests look for it.
 inline constexpr float kBackground[3] = {0.10f, 0.11f, 0.14f};
+inline constexpr float kFloor[3] = {0.20f, 0.21f, 0.25f};  // the box's solid floor
 
 struct Scene {
   const World* world = nullptr;  // plane, sphere
