@@ -4,7 +4,7 @@ to k = 1e4 .. 1e7, CVODE's BDF at rtol 1e-3 (its defaults) over a window of a fe
 its steps, and backward Euler (default settings) for 20 steps of dt = 0.001 for comparison. Writes
 experiments/results/cvode_stiff.csv and, with --readme, the table between
 <!-- cvode-stiff:begin/end --> in README.md. Also prints the h * w_max CVODE settled at, the
-constant jello-sim's cvode warning uses (kCvodeStepTimesWmax in experiments/common/modes.h).
+constant jello-sim's cvode warning uses (kCvodeStepTimesWmax in solvers/system/modes.h).
 
 Uses the Python module of the release build (build/release/python): scripts/test.sh builds it.
 """

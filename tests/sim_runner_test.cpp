@@ -12,6 +12,7 @@
 #include <cmath>
 #include <thread>
 
+#include "solvers/system/modes.h"
 #include "src/world/scene_builder.h"
 #include "src/world/world_reader.h"
 #include "tests/test_support.h"
@@ -270,6 +271,32 @@ TEST(RunnerGroup, EveryPaneShowsTheInstantAllReachedWhileTheFastOnesRunAhead) {
       "%d of %d checks had the members' latest states more than 0.01 s apart "
       "(informational: the panes showed one instant in every check, asserted)\n",
       apart, checked);
+}
+
+// Issue 40, item 2: each pane at its own sensible step by default: explicit methods at 0.9 of
+// their predicted limit on the world's fastest mode (contact included), the others at 1/60 s;
+// `--compare-dt same` (sameStep) keeps the world's.
+TEST(RunnerGroup, EachPaneStepsAtItsOwnSensibleStepUnlessTheyShareOne) {
+  const World w = test::loadWorld("jello.w");
+  const std::optional<double> wMax = compareWMax(w);
+  ASSERT_TRUE(wMax.has_value());
+  const double springs = maxAngularFrequency(Model(w), initialState(w));
+  EXPECT_NEAR(*wMax, std::sqrt(springs * springs + w.kCollision / w.mass), 1e-9 * *wMax);
+  const double r = w.dElastic / w.kElastic;
+  EXPECT_NEAR(compareStep(IntegratorKind::RK4, *wMax, r),
+              0.9 * predictedThreshold(IntegratorKind::RK4, *wMax, r), 1e-15);
+  EXPECT_EQ(compareStep(IntegratorKind::Implicit, *wMax, r), kCompareFrame);
+  EXPECT_EQ(compareStep(IntegratorKind::RK4, 1.0, 0.0), kCompareFrame);  // capped at a frame
+  SimRunner::Options o;
+  RunnerGroup own(source("jello.w"), w, {IntegratorKind::RK4, IntegratorKind::Implicit}, o,
+                  /*sameStep=*/false);
+  EXPECT_NEAR(own[0].frame().dt, compareStep(IntegratorKind::RK4, *wMax, r), 1e-15);
+  EXPECT_GT(own[0].frame().dt, w.dt);  // jello.w's 0.5 ms is well inside RK4's limit
+  EXPECT_EQ(own[1].frame().dt, kCompareFrame);
+  RunnerGroup same(source("jello.w"), w, {IntegratorKind::RK4, IntegratorKind::Implicit}, o,
+                   /*sameStep=*/true);
+  EXPECT_EQ(same[0].frame().dt, w.dt);
+  EXPECT_EQ(same[1].frame().dt, w.dt);
 }
 
 TEST(RunnerGroup, CompareModeStepsEveryIntegratorToTheSameSimulatedTime) {

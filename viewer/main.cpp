@@ -34,7 +34,8 @@ std::filesystem::path defaultWorld() {
 
 // The options that are not a ViewerOptions field as they stand.
 struct Args {
-  std::string world = defaultWorld().string(), integrator, size = "640x480", compare;
+  std::string world = defaultWorld().string(), integrator, size = "640x480", compare,
+              compareDt = "auto";
   bool panel = false, noPanel = false;
 };
 
@@ -69,6 +70,13 @@ void addOptions(CLI::App& app, jello::viewer::ViewerOptions& opt, Args& args) {
                  "Run these integrators (2-6, comma-separated, e.g. rk4,implicit) side by side in "
                  "split panes, at one shared simulated time")
       ->excludes("--integrator");
+  app.add_option("--compare-dt", args.compareDt,
+                 "Each pane's time step: auto (explicit methods at 0.9 of their predicted "
+                 "stability limit, the others at 1/60 s, said in each pane) or same (the world's, "
+                 "or --dt's)")
+      ->check(CLI::IsMember({"auto", "same"}))
+      ->needs("--compare")
+      ->capture_default_str();
   app.add_option("--size", args.size, "Window size WxH in pixels")->capture_default_str();
   app.add_option("--speed", opt.speed,
                  "Playback speed: simulated seconds per wall second (also of a recording: "
@@ -149,6 +157,7 @@ std::string apply(const Args& args, jello::viewer::ViewerOptions& opt) {
       return std::string("--texture: ") + e.what();
     }
   }
+  opt.compareSameStep = args.compareDt == "same";
   if (!args.compare.empty()) return applyCompare(args.compare, opt);
   return "";
 }

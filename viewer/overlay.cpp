@@ -123,7 +123,7 @@ void drawOverlay(const Viewport& viewport, const ViewerState& view, const Overla
       // A proportional font: as many characters as this text's own average width lets fit (all
       // of it when its widest line fits).
       const int measured = textWidth(overlay.hud, font);
-      if (measured <= viewport.width - 12) {
+      if (measured <= viewport.width - 8) {
         chars = overlay.hud.size();
       } else if (measured > 0) {
         chars = std::max<std::size_t>(
@@ -131,8 +131,9 @@ void drawOverlay(const Viewport& viewport, const ViewerState& view, const Overla
                                         double(measured)));
       }
     }
-    drawTextBlock(viewport, wrapText(overlay.hud, chars), 8, viewport.height - 6 - font.lineHeight,
-                  white, 1.0f, font);
+    const int left = overlay.compactHud ? 4 : 8;
+    drawTextBlock(viewport, wrapText(overlay.hud, chars), left,
+                  viewport.height - 6 - font.lineHeight, white, 1.0f, font);
   }
   if (!overlay.help.empty()) {
     static constexpr float pale[3] = {0.85f, 0.9f, 1.0f};

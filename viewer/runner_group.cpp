@@ -1,19 +1,42 @@
 #include "viewer/runner_group.h"
 
 #include <algorithm>
+#include <cmath>
+#include <exception>
+
+#include "solvers/system/modes.h"
+#include "src/model.h"
+#include "src/state.h"
 
 namespace jello::viewer {
 
+double compareStep(IntegratorKind kind, double wMax, double dampingRatio) {
+  const double limit = predictedThreshold(kind, wMax, dampingRatio);
+  return std::isfinite(limit) && limit > 0.0 ? std::min(0.9 * limit, kCompareFrame) : kCompareFrame;
+}
+
+std::optional<double> compareWMax(const World& world) {
+  try {
+    const double springs = maxAngularFrequency(Model(world), initialState(world));
+    return std::sqrt(springs * springs + world.kCollision / world.mass);
+  } catch (const std::exception&) {
+    return std::nullopt;  // the world's own step for every pane
+  }
+}
+
 RunnerGroup::RunnerGroup(const SceneSource& source, const World& world,
-                         const std::vector<IntegratorKind>& integrators,
-                         SimRunner::Options options) {
+                         const std::vector<IntegratorKind>& integrators, SimRunner::Options options,
+                         bool sameStep) {
   options.pacing = Pacing::Target;
   speed_ = options.speed;
   paused_ = options.paused;
   options.paused = false;  // the group's target holds them
+  const std::optional<double> wMax = sameStep || source.dt ? std::nullopt : compareWMax(world);
+  const double dampingRatio = world.kElastic > 0.0 ? world.dElastic / world.kElastic : 0.0;
   for (IntegratorKind kind : integrators) {
     SceneSource s = source;
     s.integrator = kind;
+    if (wMax) s.dt = compareStep(kind, *wMax, dampingRatio);
     runners_.push_back(std::make_unique<SimRunner>(s, world, options));
   }
   target_ = shown_ = runners_.empty() ? 0.0 : runners_.front()->frame().state.t;

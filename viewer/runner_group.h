@@ -6,17 +6,30 @@
 
 #include <deque>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "viewer/sim_runner.h"
 
 namespace jello::viewer {
 
+// The step a compare pane takes by default (--compare-dt auto): an explicit method at 0.9 of
+// its predicted stability limit (solvers/system/modes.h) on the fastest mode `wMax` with damping
+// ratio r = c/k, at most one frame (1/60 s); every other method one frame.
+inline constexpr double kCompareFrame = 1.0 / 60.0;
+double compareStep(IntegratorKind kind, double wMax, double dampingRatio);
+// The world's fastest mode at its start for compareStep: the springs' (Spectra), with a penalty
+// contact's kCollision/m added, as the cube will touch something; nothing when it cannot be
+// computed.
+std::optional<double> compareWMax(const World& world);
+
 class RunnerGroup {
  public:
-  // Each runner in Target pacing on its own thread, `world` under each integrator.
+  // Each runner in Target pacing on its own thread, `world` under each integrator, each at its
+  // compareStep unless `sameStep` (or source.dt) gives them all one.
   RunnerGroup(const SceneSource& source, const World& world,
-              const std::vector<IntegratorKind>& integrators, SimRunner::Options options);
+              const std::vector<IntegratorKind>& integrators, SimRunner::Options options,
+              bool sameStep = true);
 
   std::size_t size() const { return runners_.size(); }
   SimRunner& operator[](std::size_t i) { return *runners_[i]; }

@@ -31,8 +31,8 @@ std::string Viewer::hudLine(std::size_t pane) const {
     const bool shared = std::all_of(frames_.begin(), frames_.end(),
                                     [&](const Frame& other) { return other.dt == f.dt; });
     os << integratorName(f.integrator);
-    if (!shared) os << " dt " << format("%.2g", f.dt * 1e3) << " ms";
-    os << " t " << format("%.3f", f.state.t) << " E " << format("%.3g", f.energy.total()) << " J";
+    if (!shared) os << " dt " << format("%.2g", f.dt * 1e3) << "ms";
+    os << " t " << format("%.3f", f.state.t) << " E " << format("%.3g", f.energy.total()) << "J";
     if (pane > 0) return os.str();
     os << "\n";
     if (shared) os << "dt " << format("%.2g", f.dt * 1e3) << " ms  ";

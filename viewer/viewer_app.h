@@ -32,7 +32,8 @@ struct ViewerOptions {
   bool hud = true;
   std::optional<bool> panel;            // unset: shown interactively, hidden in recordings
   std::vector<IntegratorKind> compare;  // 2-6: these integrators side by side
-  int benchmarkFrames = 0;  // > 0: draw this many frames as fast as possible, print frames/s
+  bool compareSameStep = false;  // --compare-dt same: every pane at the world's (or --dt's) step
+  int benchmarkFrames = 0;       // > 0: draw this many frames as fast as possible, print frames/s
 };
 
 // Runs the viewer on an already loaded world. Returns the exit code: 0, 1 (no display, a

@@ -66,7 +66,7 @@ class Viewer {
           std::make_unique<SimRunner>(options.source, std::move(world), runnerOptions(options));
     } else {
       group_ = std::make_unique<RunnerGroup>(options.source, world, options.compare,
-                                             runnerOptions(options));
+                                             runnerOptions(options), options.compareSameStep);
     }
     view_.mode = options.wireframe ? DisplayMode::Wireframe : DisplayMode::Shaded;
     view_.showHud = options.hud;

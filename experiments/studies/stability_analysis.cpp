@@ -14,69 +14,6 @@
 
 namespace jello::experiments {
 
-namespace {
-
-using Complex = std::complex<double>;
-
-// Spectral radius of one step of an explicit linear model with step h on
-// x'' = -w^2 x - 2 zeta w x'.
-double amplification(LinearModel model, double h, double w, double zeta) {
-  if (model == LinearModel::SymplecticEuler) {
-    // v1 = v + h(-w^2 x - 2 zeta w v), x1 = x + h v1, as a matrix on (x, v).
-    Eigen::Matrix2d a;
-    const double d = 1.0 - 2.0 * zeta * w * h;
-    a << 1.0 - h * h * w * w, h * d, -h * w * w, d;
-    return a.eigenvalues().cwiseAbs().maxCoeff();
-  }
-  Complex lambdas[2];
-  if (zeta < 1.0) {
-    const double im = w * std::sqrt(1.0 - zeta * zeta);
-    lambdas[0] = {-zeta * w, im};
-    lambdas[1] = {-zeta * w, -im};
-  } else {
-    const double s = std::sqrt(zeta * zeta - 1.0);
-    lambdas[0] = -w * (zeta + s);
-    lambdas[1] = -w * (zeta - s);
-  }
-  double worst = 0.0;
-  for (const Complex& lambda : lambdas) {
-    const Complex z = h * lambda;
-    const Complex r = model == LinearModel::ForwardEuler
-                          ? 1.0 + z
-                          : 1.0 + z + z * z / 2.0 + z * z * z / 6.0 + z * z * z * z / 24.0;
-    worst = std::max(worst, std::abs(r));
-  }
-  return worst;
-}
-
-bool stableOnAllModes(LinearModel model, double h, double wMax, double r) {
-  // Modes fill (0, w_max]; 400 samples, denser toward the top, where the limit usually sits.
-  for (int i = 1; i <= 400; ++i) {
-    const double w = wMax * std::sqrt(i / 400.0);
-    if (amplification(model, h, w, r * w / 2.0) > 1.0 + 1e-12) return false;
-  }
-  return true;
-}
-
-}  // namespace
-
-double predictedThreshold(IntegratorKind kind, double wMax, double dampingRatio) {
-  // Every implicit method here is A-stable on this linear test equation (its linear model:
-  // backward Euler, linearized or not, and projective, which converges to it: 1/(1 - z);
-  // midpoint and the trapezoidal Newmark: (1 + z/2)/(1 - z/2); BDF2), and so is cvode's BDF.
-  const LinearModel model = linearModel(kind);
-  if (!hasStabilityLimit(model)) return std::numeric_limits<double>::infinity();
-  // Unstable already at h w_max = 1e-3 counts as never stable (forward Euler without damping
-  // grows by 1 + h^2 w^2 / 2 per step at every h).
-  double lo = 1e-3 / wMax, hi = 10.0 / wMax;
-  if (!stableOnAllModes(model, lo, wMax, dampingRatio)) return 0.0;
-  for (int i = 0; i < 200 && hi / lo > 1.0 + 1e-9; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (stableOnAllModes(model, mid, wMax, dampingRatio) ? lo : hi) = mid;
-  }
-  return lo;
-}
-
 World spinningStiffCube(double k, double damping, double spin) {
   SceneSpec spec = vibratingStiffCube(k);
   spec.dElastic = damping;

@@ -18,21 +18,19 @@
 #include <string>
 #include <string_view>
 
-#include "experiments/common/modes.h"
 #include "solvers/solver_options.h"
+#include "solvers/system/modes.h"
 #include "src/model.h"
 #include "src/world/integrator_table.h"
 #include "src/world/world.h"
 
 namespace jello::experiments {
 
-// maxAngularFrequency (experiments/common/modes.h), as the experiments call it.
+// maxAngularFrequency (solvers/system/modes.h), as the experiments call it.
 using jello::maxAngularFrequency;
 
-// The largest h at which `kind` is stable on every mode up to wMax with damping ratio
-// r * w / 2 (r = c/k in s); 0 when never stable, +infinity for the implicit methods and cvode
-// (A-stable on the linear equation; nonlinear springs can still make them blow up, measured).
-double predictedThreshold(IntegratorKind kind, double wMax, double dampingRatio);
+// predictedThreshold (solvers/system/modes.h), as the experiments call it.
+using jello::predictedThreshold;
 
 // The standard scenes, spring damping c = r k:
 //   "free": the cube at rest with its far corner pulled out by one spacing, in the middle of the

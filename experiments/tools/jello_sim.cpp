@@ -17,7 +17,6 @@
 #include <vector>
 
 #include "experiments/common/json_finite.h"
-#include "experiments/common/modes.h"
 #include "experiments/common/progress.h"
 #include "experiments/common/signal_handler.h"
 #include "experiments/tools/contact_flags.h"
@@ -25,6 +24,7 @@
 #include "experiments/tools/solver_flags.h"
 #include "solvers/linalg/solver_threads.h"
 #include "solvers/simulation.h"
+#include "solvers/system/modes.h"
 #include "src/base/atomic_file.h"
 #include "src/base/finite_options.h"
 #include "src/base/interrupt.h"

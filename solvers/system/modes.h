@@ -1,19 +1,27 @@
 // The fastest mode of a scene: linearized at a state, the modes have w_j^2 = eig(-K/m) (uniform
 // point mass m, so M^-1/2 (-K) M^-1/2 = -K/m; K includes contact springs in touch). Spectra's
 // Lanczos solver finds the largest, w_max: a general eigen-solver is thrown off by the six rigid
-// modes at 0. Used by the stability analysis (experiments/studies) and jello-sim's cvode warning.
+// modes at 0; the linear stability limit of each integrator follows from it. Used by the
+// stability analysis (experiments/studies), jello-sim's cvode warning and the viewer's compare
+// mode (each explicit pane at 0.9 of its limit).
 #pragma once
 
 #include <optional>
 
 #include "src/model.h"
 #include "src/state.h"
+#include "src/world/integrator_table.h"
 
 namespace jello {
 
 // sqrt of the largest eigenvalue of -K/m at `state` (rad/s); K is the exact (unclamped) spring
 // and contact Jacobian. Throws std::runtime_error when Spectra does not converge.
 double maxAngularFrequency(const Model& model, const State& state);
+
+// The largest h at which `kind` is stable on every mode up to wMax with damping ratio
+// r * w / 2 (r = c/k in s); 0 when never stable, +infinity for the implicit methods and cvode
+// (A-stable on the linear equation; nonlinear springs can still make them blow up, measured).
+double predictedThreshold(IntegratorKind kind, double wMax, double dampingRatio);
 
 // CVODE keeps its error at rtol on every mode the scene excites, so a lightly damped stiff mode
 // is followed, not stepped over: its steps settle at h w_max of about kCvodeStepTimesWmax
