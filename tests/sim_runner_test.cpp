@@ -241,14 +241,17 @@ TEST(SimRunner, ACommandThatFailsBecomesAnAlarmNotAStop) {
 // draws the frame at the instant all reached (RunnerGroup::shown): read from the frames' states
 // at any moment, the panes' times agree to within one of each member's steps.
 TEST(RunnerGroup, EveryPaneShowsTheInstantAllReachedWhileTheFastOnesRunAhead) {
-  World w = test::loadWorld("jello.w");
+  // jello.w with a 4^3 cube: the implicit member keeps up even under the sanitizers, where the
+  // 8^3 one had not reached its first target after 1.5 s. Checked until the shown instant has
+  // moved past 0.02 s (at most 30 s).
+  const World w = resampleCube(test::loadWorld("jello.w"), 4);
   SimRunner::Options o;
   o.speed = 1.0;
   RunnerGroup group(source("jello.w"), w,
                     {IntegratorKind::RK4, IntegratorKind::Implicit, IntegratorKind::Projective}, o);
   const auto start = WallClock::now();
   int checked = 0, apart = 0;
-  while (secondsSince(start) < 1.5) {
+  while ((group.shown() < 0.02 || checked < 20) && secondsSince(start) < 30.0) {
     group.tick(secondsSince(start));
     std::this_thread::sleep_for(milliseconds(15));
     const double shown = group.shown();
@@ -265,8 +268,8 @@ TEST(RunnerGroup, EveryPaneShowsTheInstantAllReachedWhileTheFastOnesRunAhead) {
              0.01;
     ++checked;
   }
-  EXPECT_GT(group.shown(), 0.002);  // the clock moved, at the slowest member's pace
-  EXPECT_GT(checked, 20);
+  EXPECT_GE(group.shown(), 0.02);  // the clock moved, at the slowest member's pace
+  EXPECT_GE(checked, 20);
   std::printf(
       "%d of %d checks had the members' latest states more than 0.01 s apart "
       "(informational: the panes showed one instant in every check, asserted)\n",
