@@ -373,6 +373,19 @@ TEST(Keys, TimeStepZoomCameraResetAndPullRadius) {
   EXPECT_TRUE(std::isinf(pullRadii()[v.pullRadius]));
 }
 
+// Issue 40, item 3: zooming in closes on the cube (ViewerState::focus), not the box's centre;
+// zooming out leaves the point looked at; the eye never goes below the floor.
+TEST(Keys, ZoomingInClosesOnTheCube) {
+  ViewerState v;
+  v.focus = {1.0, -0.5, -1.5};
+  for (int i = 0; i < 30; ++i) handleKey(v, 'z');
+  EXPECT_LT(norm(v.camera.center - v.focus), 0.05 * norm(v.focus));
+  const Vec3 closed = v.camera.center;
+  handleKey(v, 'x');
+  EXPECT_EQ(v.camera.center.x, closed.x);
+  EXPECT_GE(v.camera.eye().z, v.camera.minEyeZ - 1e-12);
+}
+
 TEST(Keys, SpeedPanelHelpSaveAndPause) {
   ViewerState v;
   EXPECT_EQ(handleKey(v, '>').command, Command::Speed);

@@ -51,6 +51,11 @@ void Camera::zoomBy(double factor) {
   keepAboveFloor();
 }
 
+void Camera::zoomBy(double factor, const Vec3& focus) {
+  if (factor < 1.0) center = center + (focus - center) * (1.0 - factor);
+  zoomBy(factor);
+}
+
 void Camera::pan(double dxPixels, double dyPixels, int viewportHeight) {
   const double metresPerPixel = 2.0 * radius * tanHalfFov(*this) / std::max(viewportHeight, 1);
   center = center - (right() * dxPixels - up() * dyPixels) * metresPerPixel;

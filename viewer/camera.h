@@ -36,8 +36,11 @@ struct Camera {
   void rotate(double dxPixels, double dyPixels);
   // Moves the eye closer (negative) or farther; the radius stays at least 0.5 m.
   void zoom(double metres);
-  // Zooms by a factor of the radius (0.9: 10% closer), between 0.5 m and 100 m.
+  // Zooms by a factor of the radius (0.9: 10% closer), between 0.5 m and 100 m. Zooming in
+  // also moves the point looked at the same share of the way to `focus` (the cube), so zooming
+  // closes in on the cube, not on the box's centre.
   void zoomBy(double factor);
+  void zoomBy(double factor, const Vec3& focus);
   // Middle-drag: moves the centre so that the scene follows the cursor (at the centre's depth)
   // in a window `viewportHeight` pixels high.
   void pan(double dxPixels, double dyPixels, int viewportHeight);

@@ -210,6 +210,12 @@ void Viewer::display() {
     if (group_ && !recording()) at = runner(i).frameAt(group_->shown());
     frames_[i] = at ? std::move(*at) : runner(i).frame();
   }
+  {  // zooming in closes on the (first pane's) cube
+    const State& s = primary().state;
+    Vec3 centre;
+    for (int p = 0; p < s.numPoints(); ++p) centre += s.position(p);
+    view_.focus = centre * (1.0 / std::max(1, s.numPoints()));
+  }
   if (const long published = runner().published(); published != drawnPublished_) {
     drawnPublished_ = published;
     panel_.sample(seconds(Clock::now() - started_), primary());

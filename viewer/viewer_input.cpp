@@ -110,7 +110,7 @@ void Viewer::mouse(int button, int state, int x, int y) {
   lastX_ = pressX_ = x;
   lastY_ = pressY_ = y;
   if (button == 3 || button == 4) {  // freeglut reports the wheel as buttons 3 and 4
-    if (state == GLUT_DOWN) view_.camera.zoomBy(button == 3 ? 0.9 : 1.0 / 0.9);
+    if (state == GLUT_DOWN) view_.camera.zoomBy(button == 3 ? 0.9 : 1.0 / 0.9, view_.focus);
     return glutPostRedisplay();
   }
   if (state == GLUT_UP) {

@@ -32,7 +32,7 @@ KeyResult handleKey(ViewerState& s, unsigned char key) {
       s.camera = Camera{};
       break;
     case 'z':
-      s.camera.zoomBy(0.9);  // 10% per press, as one wheel notch
+      s.camera.zoomBy(0.9, s.focus);  // 10% per press, as one wheel notch, towards the cube
       break;
     case 'x':
       s.camera.zoomBy(1.0 / 0.9);

@@ -25,6 +25,7 @@ struct ViewerState {
   bool showHud = true;     // the heads-up line
   bool pullMode = false;   // left-drag pulls the picked point (also with Shift held)
   int pullRadius = 0;      // index into pullRadii()
+  Vec3 focus;              // what zooming in closes on: the cube's centre (the viewer sets it)
   double dtScale = 1.0;    // the time step is the starting one times this
   double speed = 1.0;      // playback: simulated seconds per wall second (real time)
   bool showPanel = true;   // the ImGui panel
