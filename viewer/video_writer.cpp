@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "src/base/atomic_file.h"
+
 extern char** environ;
 
 namespace jello::viewer {
@@ -49,16 +51,8 @@ std::string VideoWriter::problem(const std::filesystem::path& path) {
   if (ext != ".mp4" && ext != ".webm") {
     return "a video is a .mp4 (H.264) or .webm (VP8) file, not '" + path.filename().string() + "'";
   }
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) return path.string() + " is a directory";
-  std::filesystem::path dir = path.parent_path();
-  if (dir.empty()) dir = ".";
-  if (!std::filesystem::is_directory(dir, ec)) {
-    return "the directory " + dir.string() + " does not exist";
-  }
-  if (::access(dir.c_str(), W_OK | X_OK) != 0) {
-    return "the directory " + dir.string() + " is not writable (" + std::strerror(errno) + ")";
-  }
+  // The checks every output has (a directory, a missing or unwritable directory).
+  if (const std::string why = outputProblem(path); !why.empty()) return why;
   if (findFfmpeg().empty()) {
     return "ffmpeg is not installed (Debian's package ffmpeg; scripts/install-deps.sh installs it)";
   }
