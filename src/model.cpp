@@ -337,7 +337,7 @@ double Model::fieldWork(const double* x0, const double* x1) const {
 
 Vec3 Model::angularMomentum(const State& s) const {
   const int n = n_;
-  const Vec3 c{s.x.head(n).mean(), s.x.segment(n, n).mean(), s.x.tail(n).mean()};
+  const Vec3 c = s.centroid();
   Vec3 L;
   for (int p = 0; p < n; ++p) {
     const Vec3 r = s.position(p) - c, v = s.velocity(p);

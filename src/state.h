@@ -20,6 +20,12 @@ struct State {
   int numPoints() const { return static_cast<int>(x.size() / 3); }
   Vec3 position(int p) const { return at(x, p); }
   Vec3 velocity(int p) const { return at(v, p); }
+  // The mean of the points' positions: the centre of mass (every point has the same mass).
+  Vec3 centroid() const {
+    const Eigen::Index n = x.size() / 3;
+    if (n == 0) return {};
+    return {x.head(n).mean(), x.segment(n, n).mean(), x.tail(n).mean()};
+  }
 
   static Vec3 at(const Eigen::VectorXd& a, int p) {
     const Eigen::Index n = a.size() / 3;

@@ -126,7 +126,7 @@ TEST(Model, ThreadedAccelerationThenEqualsTheSerialOne) {
   }
   // Into the +x wall: only the last points (the largest i) are outside.
   s.x.head(n).array() += kBoxHalfSize + 0.05 - s.x.head(n).maxCoeff();
-  const Vec3 c{s.x.head(n).mean(), s.x.segment(n, n).mean(), s.x.tail(n).mean()};
+  const Vec3 c = s.centroid();
   w.plane = Plane{0.3, 0.2, 1.0, -(0.3 * c.x + 0.2 * c.y + c.z)};  // through the centre
   w.sphere = Sphere{c, 0.3};
   Model model(w);

@@ -90,7 +90,7 @@ TEST(SpringForces, RK4OnTwoThreadsKeepsAFreeSpinningCubesMomentaAndEnergy) {
   const int n = model.numPoints();
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> jitter(-0.002, 0.002);
-  const Vec3 c{s.x.head(n).mean(), s.x.segment(n, n).mean(), s.x.tail(n).mean()};
+  const Vec3 c = s.centroid();
   for (int p = 0; p < n; ++p) {
     const Vec3 r = s.position(p) - c;
     State::set(s.x, p, s.position(p) + Vec3{jitter(rng), jitter(rng), jitter(rng)});

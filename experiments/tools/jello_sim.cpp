@@ -83,11 +83,10 @@ class Trace {
     if (!on_) return;
     const jello::State& s = sim.state();
     const Energy e = sim.model().energy(s);
-    const Eigen::Index n = s.numPoints();
+    const jello::Vec3 com = s.centroid();
     char buf[320];
     std::snprintf(buf, sizeof buf, "%ld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
-                  sim.steps(), s.t, e.kinetic, e.spring, e.contact, e.total(), s.x.head(n).mean(),
-                  s.x.segment(n, n).mean(), s.x.tail(n).mean());
+                  sim.steps(), s.t, e.kinetic, e.spring, e.contact, e.total(), com.x, com.y, com.z);
     csv_ << buf;
   }
   std::string text() const { return csv_.str(); }

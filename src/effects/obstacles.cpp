@@ -30,7 +30,10 @@ std::optional<Penetration> conePenetration(const Cone& cone, const Vec3& x) {
   if (!(h > 0.0 && h < cone.height)) return std::nullopt;
   const Vec3 radial = rel - d * h;
   const double r = norm(radial);
-  const double H = cone.height, R = cone.radius, L = std::hypot(H, R);
+  const double H = cone.height, R = cone.radius;
+  // Outside the lateral surface: most points, told before the slant length's hypot.
+  if (!(h * R - r * H > 0.0)) return std::nullopt;
+  const double L = std::hypot(H, R);
   const double lateral = (h * R - r * H) / L;  // distance to the lateral surface, > 0 inside
   if (!(lateral > 0.0)) return std::nullopt;
   const double base = H - h;
@@ -98,6 +101,17 @@ Penetration coneExterior(const Cone& cone, const Vec3& x) {
 // Long: the six faces' depths and the nearest one's gradient and Hessian.
 std::optional<Penetration> spiralPenetration(const Spiral& s, const Vec3& x) {
   const double px = x.x - s.cx, py = x.y - s.cy;
+  // Far inside the hole or beyond the rim (by 1% of the radius, past any rounding), or above
+  // the top or below the bottom: out, told before hypot and atan2.
+  const double squared = px * px + py * py;
+  if (squared < 0.98 * s.rInner * s.rInner || squared > 1.02 * s.rOuter * s.rOuter) {
+    return std::nullopt;
+  }
+  const double reachDown = s.pitch * s.turns + s.thickness;
+  if (x.z > s.zTop + 1e-9 * (1.0 + std::abs(s.zTop)) ||
+      x.z < s.zTop - reachDown - 1e-9 * (1.0 + std::abs(s.zTop) + reachDown)) {
+    return std::nullopt;
+  }
   const double r = std::hypot(px, py);
   if (!(r > s.rInner && r < s.rOuter) || r == 0.0) return std::nullopt;
   const double c = s.pitch / (2.0 * std::numbers::pi);
