@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The showcase animation: 300 frames (20 s at 15 frames/s, real-time pacing) of worlds/showcase.w,
-# a cube dropped under gravity onto a spiral ramp winding around a cone, into DIR (default
+# a cube dropped spinning under gravity onto a spiral ramp winding around a cone, with friction,
+# the camera following it (--follow), into DIR (default
 # showcase/), under Xvfb when there is no display; then a contact sheet of every 25th frame,
 # experiments/results/showcase_sheet.png, for the README.
 #   scripts/showcase.sh [DIR] [viewer options...]
@@ -10,7 +11,7 @@ dir=${1:-showcase}
 shift || true
 [ -x build/release/bin/jello ] || scripts/build.sh release >/dev/null
 viewer=(build/release/bin/jello worlds/showcase.w --record "$dir" --frames 300 --size 640x480 --no-hud
-  --texture builtin "$@")
+  --texture builtin --follow "$@")
 if [ -n "${DISPLAY:-}" ]; then
   "${viewer[@]}"
 else

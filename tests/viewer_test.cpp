@@ -139,6 +139,19 @@ TEST(Texture, TheBuiltInOneIsJelloRedAndFilesBecomePowerOfTwoSquares) {
     g += t.rgb[i + 1];
   }
   EXPECT_GT(r, 2.5 * g);
+  // A bold checker (issue 40: faint dots did not show the deformation): the middles of two
+  // neighbouring cells differ in brightness by far more than JPEG or lighting blur, and are
+  // both red.
+  const Image c = builtinTexture(70, 7);  // cells 10 pixels wide
+  auto red = [&](int x, int y) { return int(c.rgb[(std::size_t(y) * 70 + x) * 3]); };
+  auto green = [&](int x, int y) { return int(c.rgb[(std::size_t(y) * 70 + x) * 3 + 1]); };
+  for (int cell = 0; cell < 6; ++cell) {
+    const int x = 10 * cell + 5, next = x + 10;
+    EXPECT_GT(std::abs(red(x, 5) - red(next, 5)), 80) << "cell " << cell;
+    EXPECT_EQ(red(x, 5), red(next, 15)) << "cell " << cell << ": diagonal neighbours alike";
+    EXPECT_GT(red(x, 5), 3 * green(x, 5));
+    EXPECT_GT(red(next, 5), 3 * green(next, 5));
+  }
   test::TempDir dir;
   Image odd{100, 30, std::vector<std::uint8_t>(100 * 30 * 3, 200)};
   writeJpeg(dir.path() / "odd.jpg", odd);
@@ -384,6 +397,39 @@ TEST(Keys, ZoomingInClosesOnTheCube) {
   handleKey(v, 'x');
   EXPECT_EQ(v.camera.center.x, closed.x);
   EXPECT_GE(v.camera.eye().z, v.camera.minEyeZ - 1e-12);
+}
+
+// Issue 40, item 1: c follows the cube. It comes in to frame it; each frame the point looked at
+// closes the given share of the gap to the cube, and the eye turns about the box's vertical axis
+// by as much as that point did (a cube a quarter turn round the ramp is seen from its own side,
+// at the same distance and elevation); the eye stays above the floor; c again lets go.
+TEST(Keys, CFollowsTheCubeRoundTheBoxAndLetsGo) {
+  ViewerState v;
+  EXPECT_EQ(handleKey(v, 'c').command, Command::None);
+  ASSERT_TRUE(v.follow);
+  EXPECT_EQ(v.camera.radius, kFollowRadius);
+  v.camera.follow({1.0, 0.0, 0.5}, 1.0);  // snapped onto the cube at (1, 0)
+  EXPECT_EQ(v.camera.center, (Vec3{1.0, 0.0, 0.5}));
+  const double phi = v.camera.phi, theta = v.camera.theta;
+  v.camera.follow({0.0, 1.0, 0.5}, 0.5);  // half way along the chord
+  EXPECT_NEAR(norm(v.camera.center - Vec3{0.5, 0.5, 0.5}), 0.0, 1e-12);
+  EXPECT_NEAR(v.camera.phi - phi, std::numbers::pi / 4, 1e-12);  // the bearing turned 45 degrees
+  for (int i = 0; i < 60; ++i) v.camera.follow({0.0, 1.0, 0.5}, 0.5);
+  EXPECT_NEAR(v.camera.phi - phi, std::numbers::pi / 2, 1e-9);  // a quarter turn with the cube
+  EXPECT_EQ(v.camera.theta, theta);
+  EXPECT_EQ(v.camera.radius, kFollowRadius);
+  // Across the ray theta = pi the turn is the short way round, not a whole turn back.
+  v.camera.follow({-1.0, -0.01, 0.5}, 1.0);
+  v.camera.follow({-1.0, 0.01, 0.5}, 1.0);
+  v.camera.follow({-1.0, -0.01, 0.5}, 1.0);
+  EXPECT_NEAR(std::remainder(v.camera.phi - phi - std::numbers::pi, 2 * std::numbers::pi), 0.0,
+              0.03);
+  // Down by the floor, the eye stays above it.
+  v.camera.theta = -0.5;
+  v.camera.follow({1.0, 0.0, -1.95}, 1.0);
+  EXPECT_GE(v.camera.eye().z, v.camera.minEyeZ - 1e-12);
+  handleKey(v, 'c');
+  EXPECT_FALSE(v.follow);
 }
 
 TEST(Keys, SpeedPanelHelpSaveAndPause) {

@@ -63,6 +63,21 @@ void Camera::pan(double dxPixels, double dyPixels, int viewportHeight) {
   keepAboveFloor();
 }
 
+void Camera::follow(const Vec3& target, double share) {
+  const Vec3 before = center;
+  center = center + (target - center) * std::clamp(share, 0.0, 1.0);
+  center.z = std::max(center.z, minEyeZ);
+  // The eye turns about the box's vertical axis as the point looked at does, so it keeps its
+  // side of the cube (outside, where nothing is between them) however the cube goes round.
+  // Near the axis a bearing means nothing: there the eye keeps its azimuth.
+  constexpr double kNearAxis = 0.25;  // m
+  if (std::hypot(before.x, before.y) > kNearAxis && std::hypot(center.x, center.y) > kNearAxis) {
+    const double turn = std::atan2(center.y, center.x) - std::atan2(before.y, before.x);
+    phi += std::remainder(turn, 2.0 * std::numbers::pi);
+  }
+  keepAboveFloor();
+}
+
 void Camera::keepAboveFloor() {
   if (eye().z >= minEyeZ) return;
   const double limit = std::numbers::pi / 2 - 0.01;

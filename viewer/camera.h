@@ -44,9 +44,21 @@ struct Camera {
   // Middle-drag: moves the centre so that the scene follows the cursor (at the centre's depth)
   // in a window `viewportHeight` pixels high.
   void pan(double dxPixels, double dyPixels, int viewportHeight);
+  // Follow mode (key c, --follow): moves the point looked at `share` (0..1) of the way to
+  // `target` (the cube's centre) and turns the eye about the box's vertical axis by as much as
+  // that point turned about it (so the eye stays on its side of the cube), keeping the eye above
+  // the floor; once a frame, so the camera eases after the cube instead of jumping with it.
+  void follow(const Vec3& target, double share);
   // Raises the elevation just enough that the eye is at minEyeZ or above (the others call it).
   void keepAboveFloor();
 };
+
+// Follow mode's distance: close enough that the cube is a sixth of the view's height, far
+// enough that what it touches is in view too.
+inline constexpr double kFollowRadius = 4.5;  // m
+// Follow mode's easing: the camera closes 1 - exp(-elapsed / kFollowSeconds) of the gap to the
+// cube in `elapsed` wall seconds (recorded frames: 1/15 s each).
+inline constexpr double kFollowSeconds = 0.3;
 
 struct Viewport {
   int width = 640, height = 480;  // pixels

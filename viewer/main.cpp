@@ -34,8 +34,7 @@ std::filesystem::path defaultWorld() {
 
 // The options that are not a ViewerOptions field as they stand.
 struct Args {
-  std::string world = defaultWorld().string(), integrator, size = "640x480", compare,
-              compareDt = "auto";
+  std::string world = defaultWorld().string(), integrator, size, compare, compareDt = "auto";
   bool panel = false, noPanel = false;
 };
 
@@ -77,7 +76,14 @@ void addOptions(CLI::App& app, jello::viewer::ViewerOptions& opt, Args& args) {
       ->check(CLI::IsMember({"auto", "same"}))
       ->needs("--compare")
       ->capture_default_str();
-  app.add_option("--size", args.size, "Window size WxH in pixels")->capture_default_str();
+  app.add_option("--size", args.size,
+                 "Window size WxH in pixels (default 640x480; interactively with the panel, "
+                 "wider by the panel's column, so the scene keeps 640x480 beside it)");
+  app.add_option("--ui-scale", opt.uiScale,
+                 "The panel's text and spacing, times the scale it takes from the window's "
+                 "height (13 px text up to 480 px high, growing with it)")
+      ->check(CLI::Range(0.5, 4.0))
+      ->capture_default_str();
   app.add_option("--speed", opt.speed,
                  "Playback speed: simulated seconds per wall second (also of a recording: "
                  "15 frames per speed simulated seconds)")
@@ -91,6 +97,8 @@ void addOptions(CLI::App& app, jello::viewer::ViewerOptions& opt, Args& args) {
       ->excludes("--panel");
   app.add_flag("--wireframe", opt.wireframe, "Start in wireframe mode");
   app.add_flag("--field", opt.field, "Start with the force-field arrows shown (key f)");
+  app.add_flag("--follow", opt.follow,
+               "Start with the camera following the cube, closer in (key c toggles)");
   app.add_option("--texture", opt.texture,
                  "Texture the shaded cube from the start with this image (JPEG or PNG), or with "
                  "'builtin' (key t toggles; without it, t shows the built-in texture)");
@@ -131,7 +139,9 @@ std::string applyCompare(const std::string& compare, jello::viewer::ViewerOption
 std::string apply(const Args& args, jello::viewer::ViewerOptions& opt) {
   std::smatch m;
   static const std::regex sizePattern(R"((\d{2,5})x(\d{2,5}))");
-  if (!std::regex_match(args.size, m, sizePattern)) {
+  opt.sizeGiven = !args.size.empty();
+  const std::string size = opt.sizeGiven ? args.size : "640x480";
+  if (!std::regex_match(size, m, sizePattern)) {
     return "--size wants WxH in pixels, e.g. 640x480, not '" + args.size + "'";
   }
   opt.size = {std::stoi(m[1]), std::stoi(m[2])};

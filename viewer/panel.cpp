@@ -4,6 +4,7 @@
 #include <imgui.h>
 #include <imgui_impl_glut.h>
 #include <imgui_impl_opengl2.h>
+#include <imgui_internal.h>  // the window's content extent: are labels cut
 
 #include <algorithm>
 #include <cmath>
@@ -92,14 +93,39 @@ void PlotHistory::clear() {
   lastEffort_ = 0.0;
 }
 
-Panel::Panel() {
+float panelFontPixels(int height, double uiScale) {
+  constexpr double kImGuiFont = 13.0, kCourseHeight = 480.0;
+  const double grow = std::clamp(double(height) / kCourseHeight, 1.0, 3.0);
+  return static_cast<float>(std::max(6.0, std::round(kImGuiFont * grow * uiScale)));
+}
+
+Panel::Panel(double uiScale) : uiScale_(uiScale) {
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini left in the user's directory
-  ImGui::StyleColorsDark();
-  ImGui::GetStyle().Alpha = 0.92f;
   ImGui_ImplGLUT_Init();
   ImGui_ImplOpenGL2_Init();
+}
+
+// The font at the window's size, its atlas uploaded again, and the spacing scaled alike; the
+// style opaque (a translucent combo popup showed the text under it).
+void Panel::scaleTo(int height) {
+  const float pixels = panelFontPixels(height, uiScale_);
+  if (pixels == fontPixels_) return;
+  ImGuiIO& io = ImGui::GetIO();
+  io.Fonts->Clear();
+  ImFontConfig font;
+  font.SizePixels = pixels;
+  io.Fonts->AddFontDefault(&font);
+  ImGui_ImplOpenGL2_DestroyFontsTexture();
+  ImGui_ImplOpenGL2_CreateFontsTexture();
+  ImGuiStyle& style = ImGui::GetStyle();
+  style = ImGuiStyle();
+  ImGui::StyleColorsDark(&style);
+  style.ScaleAllSizes(pixels / 13.0f);
+  style.Colors[ImGuiCol_PopupBg].w = 1.0f;
+  style.Colors[ImGuiCol_WindowBg].w = 1.0f;
+  fontPixels_ = pixels;
 }
 
 Panel::~Panel() {
@@ -111,7 +137,13 @@ Panel::~Panel() {
 bool Panel::mouse(int button, int state, int x, int y) {
   if (button == 3 || button == 4) {
     if (state == GLUT_DOWN) ImGui_ImplGLUT_MouseWheelFunc(0, button == 3 ? 1 : -1, x, y);
+  } else if (button >= 0 && button < 3 && state == GLUT_UP && pressUnseen_[button]) {
+    // Released before a frame saw the press (a click under ~20 ms): released after the next.
+    releasePending_[button] = true;
+    releaseX_ = x;
+    releaseY_ = y;
   } else {
+    if (button >= 0 && button < 3 && state == GLUT_DOWN) pressUnseen_[button] = true;
     ImGui_ImplGLUT_MouseFunc(button, state, x, y);
   }
   // A release always reaches the viewer too, so that its drags end.
@@ -324,9 +356,12 @@ void Panel::plots(const Frame& frame) {
     char label[96];
     std::snprintf(label, sizeof label, "%s %.4g", overlay, double(data.back()));
     // |L| as its relative change over the window: its round-off (1e-15) is no trend.
-    if (series == PlotHistory::AngularMomentum && std::abs(data.front()) > 0.0f) {
+    // Relative to the largest |L| in the window, not to the first: a cube thrown without spin
+    // starts at |L| ~ 1e-15, and its change over that read 5e14.
+    const double largest = *std::max_element(data.begin(), data.end());
+    if (series == PlotHistory::AngularMomentum && largest > 0.0) {
       const double first = data.front();
-      for (float& x : data) x = float((double(x) - first) / first);
+      for (float& x : data) x = float((double(x) - first) / largest);
       std::snprintf(label, sizeof label, "change %.2g", double(data.back()));
     }
     // A span below 1e-6 of the values (1e-6 absolute for a relative change) is drawn flat.
@@ -334,8 +369,9 @@ void Panel::plots(const Frame& frame) {
     const auto [lo, hi] = relative ? plotRange(data, 0.0) : plotRange(data, 1e-6);
     const auto [rlo, rhi] =
         relative && hi - lo < 2e-6f ? std::pair(lo - 1e-6f, hi + 1e-6f) : std::pair(lo, hi);
+    const float em = ImGui::GetFontSize();
     ImGui::PlotLines(PlotHistory::kNames[series], data.data(), int(data.size()), 0, label, rlo, rhi,
-                     ImVec2(130.0f, 32.0f));
+                     ImVec2(10.0f * em, 2.5f * em));
   };
   for (int s : {PlotHistory::Total, PlotHistory::Kinetic, PlotHistory::Spring, PlotHistory::Contact,
                 PlotHistory::Field, PlotHistory::AngularMomentum}) {
@@ -345,8 +381,9 @@ void Panel::plots(const Frame& frame) {
   if (statistic(frame, "last_step_s")) plot(PlotHistory::StepSize, "");
 }
 
-void Panel::draw(const Frame& frame, ViewerState& view, SimRunner& runner) {
+void Panel::prepare(const Frame& frame, ViewerState& view, SimRunner& runner) {
   if (frame.generation != generation_) syncFromWorld(frame);
+  scaleTo(int(ImGui::GetIO().DisplaySize.y));
   if (!warmedUp_) {
     // ImGui sizes an auto-fitting window in its first frame and draws it from the second: a
     // pass that is not rendered, so that the first drawn (or recorded) frame has the panel.
@@ -360,18 +397,32 @@ void Panel::draw(const Frame& frame, ViewerState& view, SimRunner& runner) {
   ImGui_ImplGLUT_NewFrame();
   build(frame, view, runner);
   ImGui::Render();
+}
+
+void Panel::render() {
   ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData());
+  pressUnseen_.fill(false);  // this frame saw them
+  for (int button = 0; button < 3; ++button) {
+    if (!releasePending_[button]) continue;
+    releasePending_[button] = false;
+    ImGui_ImplGLUT_MouseFunc(button, GLUT_UP, releaseX_, releaseY_);
+    glutPostRedisplay();  // the next frame sees the release: the click
+  }
 }
 
 void Panel::build(const Frame& frame, ViewerState& view, SimRunner& runner) {
+  width_ = 0;
   if (view.showPanel) {
-    // A narrow column at the right, below the heads-up: the cube stays in view at 640x480.
-    ImGui::SetNextWindowPos(ImVec2(ImGui::GetIO().DisplaySize.x - 258.0f, 44.0f),
-                            ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowSize(ImVec2(250.0f, 0.0f), ImGuiCond_FirstUseEver);
-    ImGui::SetNextWindowBgAlpha(0.75f);
-    ImGui::Begin("panel (m hides)", &view.showPanel);
-    ImGui::PushItemWidth(130.0f);
+    // A column at the right edge, the window's height (scrolling when taller), as wide as its
+    // widest line (a width of 0 asks ImGui to fit it every frame): no label is cut, and the
+    // viewer draws the scene beside it.
+    const ImVec2 display = ImGui::GetIO().DisplaySize;
+    ImGui::SetNextWindowPos(ImVec2(display.x, 0.0f), ImGuiCond_Always, ImVec2(1.0f, 0.0f));
+    ImGui::SetNextWindowSize(ImVec2(0.0f, display.y), ImGuiCond_Always);
+    ImGui::Begin("panel (m hides)", &view.showPanel,
+                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+    const float em = ImGui::GetFontSize();
+    ImGui::PushItemWidth(10.0f * em);
     // Integrator and time step.
     IntegratorKind kind = frame.integrator;
     if (tableCombo("integrator", kind, allIntegrators(), integratorName) && !frame.divergence) {
@@ -415,6 +466,9 @@ void Panel::build(const Frame& frame, ViewerState& view, SimRunner& runner) {
       if (frame.solver.empty()) ImGui::TextUnformatted("(none: an explicit integrator)");
     }
     ImGui::PopItemWidth();
+    const ImGuiWindow* window = ImGui::GetCurrentWindow();
+    labelsCut_ = window->DC.CursorMaxPos.x > window->WorkRect.Max.x + 0.5f;
+    width_ = view.showPanel ? int(std::ceil(ImGui::GetWindowWidth())) : 0;
     ImGui::End();
   }
 }

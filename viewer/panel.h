@@ -40,10 +40,19 @@ struct PlotHistory {
   double lastEffort_ = 0.0;
 };
 
+// The panel's text size in pixels for a window `height` pixels high: ImGui's 13 px at the
+// course's 480 and below, growing with the window up to three times that, times `uiScale`
+// (--ui-scale), rounded to whole pixels.
+float panelFontPixels(int height, double uiScale);
+// The panel's width at 13 px text on jello.w, its sections closed (as the viewer reports it
+// after a recording with --panel): the column an interactive window opens wider by, so the
+// scene keeps its size beside it.
+inline constexpr double kPanelColumn = 248.0;  // pixels
+
 class Panel {
  public:
-  // After the GL window exists.
-  Panel();
+  // After the GL window exists. `uiScale` (--ui-scale) multiplies the text and spacing.
+  explicit Panel(double uiScale = 1.0);
   ~Panel();
   Panel(const Panel&) = delete;
   Panel& operator=(const Panel&) = delete;
@@ -60,8 +69,16 @@ class Panel {
 
   // Records a sample of a newly published frame.
   void sample(double wallTime, const Frame& frame) { history_.add(wallTime, frame); }
-  // Draws the panel (when view.showPanel) over the frame just drawn; edits go to `runner`.
-  void draw(const Frame& frame, ViewerState& view, SimRunner& runner);
+  // Lays the panel out (when view.showPanel), before the scene is drawn, so that width() is
+  // this frame's; edits go to `runner`. Then render() draws it over the scene.
+  void prepare(const Frame& frame, ViewerState& view, SimRunner& runner);
+  void render();
+  // The panel is a column at the window's right edge, its whole height, as wide as its widest
+  // line (labels are never cut): its width in pixels as last drawn (0 hidden or not yet drawn).
+  // The scene is drawn beside it, in the rest of the window.
+  int width() const { return width_; }
+  // Whether a line of the last drawn panel did not fit its width (false: every label whole).
+  bool labelsCut() const { return labelsCut_; }
 
  private:
   void build(const Frame& frame, ViewerState& view, SimRunner& runner);
@@ -88,6 +105,15 @@ class Panel {
   std::optional<Sphere> savedSphere_;
   bool plane_ = false, sphere_ = false;
   bool warmedUp_ = false;
+  double uiScale_ = 1.0;
+  float fontPixels_ = 0.0f;  // the font atlas's size (rebuilt when the window's height asks)
+  int width_ = 0;
+  bool labelsCut_ = false;
+  // A click shorter than a frame: its release waits for a frame that has seen the press
+  // (ImGui 1.86 reads the button's state once a frame and would miss the click).
+  std::array<bool, 3> pressUnseen_{}, releasePending_{};
+  int releaseX_ = 0, releaseY_ = 0;
+  void scaleTo(int height);
 };
 
 }  // namespace jello::viewer

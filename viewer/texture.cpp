@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <random>
 
 namespace jello::viewer {
 
@@ -27,32 +26,25 @@ Image resampled(const Image& image, int size) {
 
 }  // namespace
 
-Image builtinTexture(int size) {
+Image builtinTexture(int size, int cells) {
   Image image;
   image.width = image.height = size;
   image.rgb.resize(static_cast<std::size_t>(size) * size * 3);
-  // Bubbles: a fixed scatter of discs, lighter towards their centres.
-  std::mt19937 rng(1234);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  struct Bubble {
-    double x, y, r;
-  };
-  std::vector<Bubble> bubbles;
-  for (int i = 0; i < 18; ++i) bubbles.push_back({u(rng), u(rng), 0.03 + 0.06 * u(rng)});
+  cells = std::max(cells, 1);
+  // A bold checker of jello red and deep red, with a dark line along each cell's edge: every
+  // cell is a patch of the face, so the cube's shear and stretch show as the cells deform.
   for (int y = 0; y < size; ++y) {
     for (int x = 0; x < size; ++x) {
-      const double fx = (x + 0.5) / size, fy = (y + 0.5) / size;
-      // Darker towards the face's rim, so the cube's edges read.
-      const double edge = std::min({fx, fy, 1.0 - fx, 1.0 - fy});
-      double light = 0.75 + 0.25 * std::min(1.0, edge / 0.12);
-      for (const Bubble& b : bubbles) {
-        const double d = std::hypot(fx - b.x, fy - b.y) / b.r;
-        if (d < 1.0) light += 0.35 * (1.0 - d * d);
-      }
+      const double fx = (x + 0.5) / size * cells, fy = (y + 0.5) / size * cells;
+      const int cx = std::min(cells - 1, int(fx)), cy = std::min(cells - 1, int(fy));
+      const double edge = std::min({fx - cx, fy - cy, 1.0 - (fx - cx), 1.0 - (fy - cy)});
+      const bool light = (cx + cy) % 2 == 0;
+      double shade = light ? 1.0 : 0.55;
+      if (edge < 0.06) shade *= 0.6;
       const std::size_t i = (static_cast<std::size_t>(y) * size + x) * 3;
-      image.rgb[i] = static_cast<std::uint8_t>(std::min(255.0, 230.0 * light));
-      image.rgb[i + 1] = static_cast<std::uint8_t>(std::min(255.0, 60.0 * light));
-      image.rgb[i + 2] = static_cast<std::uint8_t>(std::min(255.0, 80.0 * light));
+      image.rgb[i] = static_cast<std::uint8_t>(235.0 * shade);
+      image.rgb[i + 1] = static_cast<std::uint8_t>((light ? 55.0 : 25.0) * shade);
+      image.rgb[i + 2] = static_cast<std::uint8_t>((light ? 75.0 : 40.0) * shade);
     }
   }
   return image;

@@ -155,9 +155,14 @@ void Viewer::waitForRecordedFrame() {
   });
 }
 
+Viewport Viewer::sceneViewport() const {
+  if (group_ || !view_.showPanel || panel_.width() <= 0) return viewport_;
+  return {std::max(1, viewport_.width - panel_.width()), viewport_.height};
+}
+
 void Viewer::drawPanes() {
   if (!group_) {
-    drawFrame(view_, viewport_, scene(0), overlay(0));
+    drawFrame(view_, sceneViewport(), scene(0), overlay(0));
     return;
   }
   const std::vector<Pane> panes = paneLayout(int(group_->size()), viewport_);
@@ -210,11 +215,13 @@ void Viewer::display() {
     if (group_ && !recording()) at = runner(i).frameAt(group_->shown());
     frames_[i] = at ? std::move(*at) : runner(i).frame();
   }
-  {  // zooming in closes on the (first pane's) cube
-    const State& s = primary().state;
-    Vec3 centre;
-    for (int p = 0; p < s.numPoints(); ++p) centre += s.position(p);
-    view_.focus = centre * (1.0 / std::max(1, s.numPoints()));
+  // Zooming in closes on the (first pane's) cube; follow mode eases the camera after it, by the
+  // wall time since the last frame (a recorded frame's: 1/15 s, so recordings repeat exactly).
+  view_.focus = primary().state.centroid();
+  if (view_.follow) {
+    const double elapsed = recording() ? 1.0 / kRecordedFramesPerSecond
+                                       : std::min(seconds(Clock::now() - lastDraw_), 1.0);
+    view_.camera.follow(view_.focus, 1.0 - std::exp(-elapsed / kFollowSeconds));
   }
   if (const long published = runner().published(); published != drawnPublished_) {
     drawnPublished_ = published;
@@ -230,8 +237,9 @@ void Viewer::display() {
     view_.paused = true;
   }
   if (!stopped) divergenceShown_ = false;
+  if (!group_) panel_.prepare(primary(), view_, runner());  // its width first: the scene's beside
   drawPanes();
-  if (!group_) panel_.draw(primary(), view_, runner());
+  if (!group_) panel_.render();
   lastDraw_ = Clock::now();
 
   if (screenshotPending_) {
@@ -292,6 +300,11 @@ void Viewer::display() {
             framesDrawn_, where.c_str(), recordStart_, latestTime(),
             options_.courseTime ? "course time" : ("speed " + format("%.4g", view_.speed)).c_str(),
             recordSpan_, framesDrawn_ / kRecordedFramesPerSecond);
+        if (view_.showPanel && !group_) {
+          std::printf("jello: the panel %d px wide beside the scene's %d, %s\n", panel_.width(),
+                      sceneViewport().width,
+                      panel_.labelsCut() ? "a line cut at its edge" : "every label whole");
+        }
       } else {
         const double elapsed = seconds(now - started_);
         const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
@@ -370,7 +383,15 @@ int runViewer(const ViewerOptions& options, World world) {
   glutSetOption(GLUT_ACTION_ON_WINDOW_CLOSE, GLUT_ACTION_GLUTMAINLOOP_RETURNS);
   glutSetOption(GLUT_MULTISAMPLE, 4);
   glutInitDisplayMode(GLUT_DOUBLE | GLUT_RGB | GLUT_DEPTH | GLUT_STENCIL | GLUT_MULTISAMPLE);
-  glutInitWindowSize(options.size.width, options.size.height);
+  // Interactively the panel opens beside the scene: without --size, the window is wider by
+  // the panel's column at its default text size, so the scene keeps the course's 640x480.
+  const bool interactive =
+      options.recordDir.empty() && options.recordVideo.empty() && options.benchmarkFrames == 0;
+  const bool besidePanel =
+      interactive && !options.sizeGiven && options.compare.empty() && options.panel.value_or(true);
+  glutInitWindowSize(
+      options.size.width + (besidePanel ? int(std::lround(kPanelColumn * options.uiScale)) : 0),
+      options.size.height);
   const int window = glutCreateWindow("jello");
   if (window <= 0) {
     std::cerr << "jello: cannot create a window\n";

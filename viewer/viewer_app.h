@@ -24,10 +24,13 @@ struct ViewerOptions {
   std::filesystem::path recordVideo;  // non-empty: the same frames as a video (.mp4, .webm)
   int frames = 0;
   Viewport size;
-  double speed = 1.0;             // playback: simulated seconds per wall second
-  bool courseTime = false;        // the original pacing: the world's n*dt per displayed frame
-  bool wireframe = false;         // start in wireframe
-  bool field = false;             // start with the field arrows shown
+  bool sizeGiven = true;    // --size given; else an interactive window with the panel is wider
+  double uiScale = 1.0;     // --ui-scale: the panel's text and spacing, times its window's scale
+  double speed = 1.0;       // playback: simulated seconds per wall second
+  bool courseTime = false;  // the original pacing: the world's n*dt per displayed frame
+  bool wireframe = false;   // start in wireframe
+  bool field = false;       // start with the field arrows shown
+  bool follow = false;      // start with the camera following the cube (key c)
   std::filesystem::path texture;  // non-empty: this image ("builtin": ours) from the start
   bool hud = true;
   std::optional<bool> panel;            // unset: shown interactively, hidden in recordings

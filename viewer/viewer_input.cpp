@@ -135,7 +135,7 @@ void Viewer::mouse(int button, int state, int x, int y) {
       const std::optional<PanePixel> at =
           group_ ? paneAt(panes, viewport_, x, y) : PanePixel{0, double(x), double(y)};
       if (!at) return;
-      dragPane_ = group_ ? panes[std::size_t(at->pane)].size : viewport_;
+      dragPane_ = group_ ? panes[std::size_t(at->pane)].size : sceneViewport();
       dragOffsetX_ = x - at->x;
       dragOffsetY_ = y - at->y;
       const Frame& f = frames_[std::size_t(at->pane)];

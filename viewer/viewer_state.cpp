@@ -31,6 +31,11 @@ KeyResult handleKey(ViewerState& s, unsigned char key) {
     case 'e':
       s.camera = Camera{};
       break;
+    case 'c':  // following brings the camera in to frame the cube (it stays where it is after)
+      s.follow = !s.follow;
+      if (s.follow) s.camera.radius = std::min(s.camera.radius, kFollowRadius);
+      s.camera.keepAboveFloor();
+      break;
     case 'z':
       s.camera.zoomBy(0.9, s.focus);  // 10% per press, as one wheel notch, towards the cube
       break;
@@ -133,6 +138,7 @@ std::span<const KeyBinding> keyBindings() {
       {"z x, wheel", "zoom in/out"},
       {"middle-drag", "pan the camera"},
       {"e", "reset the camera"},
+      {"c", "camera follows the cube on/off (--follow)"},
       {"v", "wireframe/shaded"},
       {"t", "texture on the shaded cube on/off (--texture FILE, else a built-in one)"},
       {"s h b", "wireframe: structural, shear, bend springs on/off"},

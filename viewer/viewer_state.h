@@ -31,6 +31,7 @@ struct ViewerState {
   bool showPanel = true;   // the ImGui panel
   bool showHelp = false;   // the key table on screen
   bool texture = false;    // the shaded cube textured
+  bool follow = false;     // the camera follows the cube (key c, --follow)
 };
 
 inline constexpr double kMinSpeed = 1.0 / 1024, kMaxSpeed = 64.0;

@@ -60,7 +60,8 @@ inline SimRunner::Options runnerOptions(const ViewerOptions& options) {
 
 class Viewer {
  public:
-  Viewer(const ViewerOptions& options, World world) : options_(options), viewport_(options.size) {
+  Viewer(const ViewerOptions& options, World world)
+      : options_(options), panel_(options.uiScale), viewport_(options.size) {
     if (options.compare.empty()) {
       single_ =
           std::make_unique<SimRunner>(options.source, std::move(world), runnerOptions(options));
@@ -82,6 +83,11 @@ class Viewer {
     recordSpan_ =
         recordedFrameSpan(options.speed, options.courseTime, primary().geometry->frameTime);
     recordStart_ = primary().state.t;
+    if (options.follow) {  // framed from the first frame on
+      view_.follow = true;
+      view_.camera.radius = kFollowRadius;
+      view_.camera.follow(primary().state.centroid(), 1.0);
+    }
   }
 
   void display();
@@ -144,6 +150,8 @@ class Viewer {
     return t;
   }
   void drawPanes();
+  // Where the scene is drawn: the window, less the panel's column at the right when it shows.
+  Viewport sceneViewport() const;
 
   std::unique_ptr<SimRunner> single_;
   std::unique_ptr<RunnerGroup> group_;
