@@ -16,27 +16,28 @@
 #include <utility>
 #include <vector>
 
-#include "experiments/common/json_finite.h"
 #include "experiments/common/progress.h"
 #include "experiments/common/signal_handler.h"
 #include "experiments/tools/contact_flags.h"
 #include "experiments/tools/output_check.h"
+#include "experiments/tools/sim_report.h"
 #include "experiments/tools/solver_flags.h"
 #include "solvers/linalg/solver_threads.h"
 #include "solvers/simulation.h"
 #include "solvers/system/modes.h"
-#include "src/base/atomic_file.h"
 #include "src/base/finite_options.h"
 #include "src/base/interrupt.h"
 #include "src/base/out_of_memory.h"
 #include "src/world/scene_builder.h"
 #include "src/world/world_reader.h"
-#include "src/world/world_writer.h"
 
 namespace {
 
 using jello::Energy;
 using jello::Simulation;
+using jello::simtool::Options;
+using jello::simtool::Outcome;
+using jello::simtool::Trace;
 
 constexpr int kExitInput = 1;
 constexpr int kExitUsage = 2;
@@ -49,52 +50,6 @@ extern "C" void onInterrupt(int signo) {
   interruptSignal = signo;
   jello::requestInterrupt(signo);  // polled inside long steps too (src/base/interrupt.h)
 }
-
-struct Options {
-  std::string world;
-  std::string integrator;
-  std::optional<double> dt;
-  std::optional<double> time;
-  std::optional<long> steps;
-  std::optional<int> cube;
-  std::string out, trace, stats;
-  bool outGiven = false, traceGiven = false, statsGiven = false;  // even as an empty string
-  long every = 100;
-  bool quiet = false;
-  bool strict = false;          // an unconverged step stops the run (exit 4)
-  jello::SolverOptions solver;  // from the solver flags (solver_flags.h)
-  jello::ContactFlags contact;  // over the file's (contact_flags.h)
-  jello::ReaderLimits limits;
-};
-
-nlohmann::json toJson(const Energy& e) {
-  return {{"kinetic_J", e.kinetic},
-          {"spring_J", e.spring},
-          {"contact_J", e.contact},
-          {"total_J", e.total()}};
-}
-
-class Trace {
- public:
-  explicit Trace(bool on) : on_(on) {
-    if (on_) csv_ << "step,t_s,kinetic_J,spring_J,contact_J,total_J,com_x_m,com_y_m,com_z_m\n";
-  }
-  void row(const Simulation& sim) {
-    if (!on_) return;
-    const jello::State& s = sim.state();
-    const Energy e = sim.model().energy(s);
-    const jello::Vec3 com = s.centroid();
-    char buf[320];
-    std::snprintf(buf, sizeof buf, "%ld,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n",
-                  sim.steps(), s.t, e.kinetic, e.spring, e.contact, e.total(), com.x, com.y, com.z);
-    csv_ << buf;
-  }
-  std::string text() const { return csv_.str(); }
-
- private:
-  bool on_;
-  std::ostringstream csv_;
-};
 
 void warnOfLightlyDampedStiffness(const Simulation& sim, double simulated, double kElastic,
                                   double dElastic) {
@@ -109,19 +64,6 @@ void warnOfLightlyDampedStiffness(const Simulation& sim, double simulated, doubl
       "\"cvode on very stiff scenes\")\n",
       w->wMax, w->dampingRatio, w->steps, simulated, jello::kCvodeStepTimesWmax);
 }
-
-// What a run came to: the steps done, its wall time, and why it stopped early if it did.
-struct Outcome {
-  long total = 0;  // steps asked for
-  long done = 0;   // steps taken (a diverged step not counted)
-  double wall = 0.0;
-  bool diverged = false;
-  int interrupted = 0;      // the signal that stopped it
-  std::string failure;      // a step that could not run (a resource limit), not a divergence
-  std::string unconverged;  // --strict: the step accepted unconverged that stopped the run
-  jello::Energy start, end;
-  jello::Vec3 startL, endL;
-};
 
 // The world of the command line, its integrator overridable; nothing after an error (said).
 std::optional<jello::World> loadWorld(const Options& opt) {
@@ -211,158 +153,6 @@ void stepAll(Simulation& sim, const Options& opt, Trace& trace, Outcome& o) {
   o.done = o.diverged ? sim.steps() - 1 : sim.steps();  // an unconverged step was taken
   o.end = sim.model().energy(sim.state());
   o.endL = sim.model().angularMomentum(sim.state());
-}
-
-// On standard error: `count` steps were accepted unconverged, and what to do about it.
-void warnUnconverged(const Options& opt, const Simulation& sim, double count) {
-  // An unconverged step that then diverged is not in sim.steps(): "1 of 0 steps" said so.
-  const long taken = std::max(sim.steps(), static_cast<long>(count));
-  if (sim.integratorKind() == jello::IntegratorKind::ImplicitLinear) {
-    // Its Newton runs only where contact begins, to a cap of its own: the Newton options do
-    // nothing for it.
-    std::fprintf(stderr,
-                 "jello-sim: warning: %.0f of %ld steps taken were accepted unconverged: at a "
-                 "contact onset implicit-linear iterates at most %d times to a residual of %g, "
-                 "then keeps its step (--strict makes this an error; the converged method: "
-                 "--integrator implicit; a contact whose force has no jump: --contact smooth; "
-                 "solvers/README.md, \"implicit-linear\")\n",
-                 count, taken, opt.solver.implicit.contactNewtonIterations,
-                 opt.solver.implicit.contactNewtonTolerance);
-    return;
-  }
-  const int halvings = opt.solver.implicit.newtonHalvings;
-  const std::string retried =
-      halvings > 0 ? ", even in sub-steps of 1/" + std::to_string(1 << halvings) : "";
-  std::fprintf(stderr,
-               "jello-sim: warning: %.0f of %ld steps taken were accepted unconverged: Newton "
-               "did not converge within %d iterations%s (raise --newton-iters or "
-               "--newton-halvings; --strict makes this an error; where a point meets a wall "
-               "at speed the penalty's damping force jumps and the step's equations may have "
-               "no root: --contact smooth; solvers/README.md, \"implicit\")\n",
-               count, taken, opt.solver.implicit.newtonMaxIterations, retried.c_str());
-}
-
-// The summary as JSON (--stats), and on stderr what went wrong: unconverged steps, a signal, a
-// failure, a divergence.
-nlohmann::json statistics(const Options& opt, const Simulation& sim, const Outcome& o) {
-  const jello::State& s = sim.state();
-  nlohmann::json stats = {
-      {"world", opt.world},
-      {"integrator", std::string(jello::integratorName(sim.integratorKind()))},
-      {"dt_s", sim.dt()},
-      {"contact",
-       {{"model", std::string(jello::contactModelName(sim.world().contact.model))},
-        {"layer_m", sim.world().contact.layer},
-        {"dhat_m", sim.world().contact.dhat},
-        {"kappa_N_per_m", sim.world().contact.kappa},
-        {"friction_mu", sim.world().contact.mu},
-        {"slip_speed_m_per_s", sim.world().contact.slipSpeed},
-        {"friction_work_J", sim.frictionWork()}}},
-      {"points", s.numPoints()},
-      {"springs", sim.model().springs().numSprings()},
-      {"steps", o.done},
-      {"simulated_time_s", s.t},
-      {"wall_time_s", o.wall},
-      {"steps_per_s", o.wall > 0 ? double(o.done) / o.wall : 0.0},
-      {"real_time_factor", o.wall > 0 ? s.t / o.wall : 0.0},
-      {"energy_start", toJson(o.start)},
-      {"energy_end", toJson(o.end)},
-      {"angular_momentum_start_kg_m2_per_s", {o.startL.x, o.startL.y, o.startL.z}},
-      {"angular_momentum_end_kg_m2_per_s", {o.endL.x, o.endL.y, o.endL.z}},
-      {"diverged", o.diverged},
-      {"interrupted", o.interrupted != 0},
-  };
-  // The least signed distance to a solid over the run (< 0: the deepest penetration); null
-  // without solids.
-  if (const std::optional<double> d = sim.minObstacleDistance()) {
-    stats["min_obstacle_distance_m"] = *d;
-  } else {
-    stats["min_obstacle_distance_m"] = nullptr;
-    stats["null_because"]["min_obstacle_distance_m"] = "the scene has no solid";
-  }
-  for (const jello::Statistic& st : sim.integrator().statistics()) {
-    stats["solver"][st.name] = st.value;
-    if (st.name == "newton_unconverged_steps" && st.value > 0 && o.unconverged.empty()) {
-      warnUnconverged(opt, sim, st.value);
-    }
-  }
-  if (o.interrupted) {
-    std::fprintf(stderr, "jello-sim: interrupted (signal %d) at t = %g s, after step %ld of %ld\n",
-                 o.interrupted, s.t, o.done, o.total);
-  }
-  if (!o.failure.empty()) {
-    stats["failure"] = o.failure;
-    std::fprintf(stderr, "jello-sim: error: %s\n", o.failure.c_str());
-  }
-  if (!o.unconverged.empty()) {
-    stats["unconverged"] = o.unconverged;
-    std::fprintf(stderr, "jello-sim: error: %s\n", o.unconverged.c_str());
-  }
-  if (o.diverged) {
-    const jello::Divergence& d = *sim.divergence();
-    stats["divergence"] = {{"time_s", d.time}, {"step", d.step}, {"reason", d.reason}};
-    std::fprintf(stderr, "jello-sim: %s\n", d.describe().c_str());
-  }
-  jello::explainNonFinite(stats);
-  return stats;
-}
-
-void printSummary(const Options& opt, const Simulation& sim, const Outcome& o) {
-  const jello::State& s = sim.state();
-  const std::string name(jello::integratorName(sim.integratorKind()));
-  std::printf("world        %s (%d points, %d springs)\n", opt.world.c_str(), s.numPoints(),
-              sim.model().springs().numSprings());
-  std::printf("integrator   %s, dt = %g s\n", name.c_str(), sim.dt());
-  std::printf("steps        %ld%s\n", o.done,
-              o.diverged      ? " (then diverged)"
-              : o.interrupted ? " (interrupted)"
-              : !o.failure.empty() || !o.unconverged.empty()
-                  ? " (then stopped: see the error above)"
-                  : "");
-  std::printf("simulated    %.6g s\n", s.t);
-  std::printf("wall time    %.3f s (%.0f steps/s, %.2fx real time)\n", o.wall,
-              o.wall > 0 ? double(o.done) / o.wall : 0.0, o.wall > 0 ? s.t / o.wall : 0.0);
-  std::printf("energy (J)   %12s %12s %12s %12s\n", "kinetic", "spring", "contact", "total");
-  std::printf("  start      %12.6g %12.6g %12.6g %12.6g\n", o.start.kinetic, o.start.spring,
-              o.start.contact, o.start.total());
-  std::printf("  %-10s %12.6g %12.6g %12.6g %12.6g\n", o.diverged ? "last sane" : "end",
-              o.end.kinetic, o.end.spring, o.end.contact, o.end.total());
-  for (const jello::Statistic& st : sim.integrator().statistics()) {
-    std::printf("  %-28s %.6g\n", st.name.c_str(), st.value);
-  }
-}
-
-// Every output that can be written is: one failing does not lose the others. A diverged,
-// interrupted or failed run saves no world (its last state is not the state at the requested
-// time); its trace and stats are complete up to where it stopped, and say so. False when a
-// write failed.
-bool writeOutputs(const Options& opt, const Simulation& sim, const Outcome& o, const Trace& trace,
-                  const nlohmann::json& stats) {
-  bool writeFailed = false;
-  const auto attempt = [&](auto&& write) {
-    try {
-      write();
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "jello-sim: error: %s\n", e.what());
-      writeFailed = true;
-    }
-  };
-  const bool complete = !o.diverged && !o.interrupted && o.failure.empty() && o.unconverged.empty();
-  if (!opt.trace.empty()) attempt([&] { jello::writeFileAtomically(opt.trace, trace.text()); });
-  if (!opt.stats.empty()) {
-    attempt([&] { jello::writeFileAtomically(opt.stats, stats.dump(2) + "\n"); });
-  }
-  if (!opt.out.empty() && complete)
-    attempt([&] { jello::writeWorld(sim.currentWorld(), opt.out); });
-  if (writeFailed) return false;
-  if (!complete && !opt.out.empty()) {
-    std::fprintf(stderr, "jello-sim: %s not written (the simulation %s)\n", opt.out.c_str(),
-                 o.diverged               ? "diverged"
-                 : o.interrupted          ? "was interrupted"
-                 : !o.unconverged.empty() ? "stopped at an unconverged step"
-                                          : "could not go on");
-  }
-  return true;
 }
 
 int run(const Options& opt) {
