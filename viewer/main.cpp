@@ -82,7 +82,7 @@ void addOptions(CLI::App& app, jello::viewer::ViewerOptions& opt, Args& args) {
   app.add_option("--ui-scale", opt.uiScale,
                  "The panel's text and spacing, times the scale it takes from the window's "
                  "height (13 px text up to 480 px high, growing with it)")
-      ->check(CLI::Range(0.5, 4.0))
+      ->check(jello::cli::range(0.5, 4.0))
       ->capture_default_str();
   app.add_option("--speed", opt.speed,
                  "Playback speed: simulated seconds per wall second (also of a recording: "

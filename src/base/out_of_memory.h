@@ -10,6 +10,7 @@
 #include <cstring>
 #include <exception>
 #include <new>
+#include <system_error>
 
 namespace jello {
 
@@ -37,6 +38,14 @@ inline void onTerminate() {
       std::rethrow_exception(e);
     } catch (const std::bad_alloc&) {
       onOutOfMemory();
+    } catch (const std::system_error& ex) {
+      // A thread that could not be started for want of memory (its stack, under a memory
+      // limit: EAGAIN) is memory running out too.
+      if (ex.code() == std::errc::resource_unavailable_try_again ||
+          ex.code() == std::errc::not_enough_memory) {
+        onOutOfMemory();
+      }
+      what = ex.what();
     } catch (const std::exception& ex) {
       what = ex.what();
     } catch (...) {
