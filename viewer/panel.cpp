@@ -93,6 +93,29 @@ void PlotHistory::clear() {
   lastEffort_ = 0.0;
 }
 
+bool ClickLatch::event(int button, bool down, int x, int y) {
+  if (button < 0 || button >= 3) return true;
+  const auto b = static_cast<std::size_t>(button);
+  if (down) {
+    pressUnseen_[b] = true;
+    return true;
+  }
+  if (!pressUnseen_[b]) return true;
+  held_[b] = true;  // released before a frame saw the press: after the next one
+  releases_[b] = {button, x, y};
+  return false;
+}
+
+std::vector<ClickLatch::Release> ClickLatch::frameSeen() {
+  std::vector<Release> out;
+  for (std::size_t b = 0; b < 3; ++b) {
+    pressUnseen_[b] = false;
+    if (held_[b]) out.push_back(releases_[b]);
+    held_[b] = false;
+  }
+  return out;
+}
+
 float panelFontPixels(int height, double uiScale) {
   constexpr double kImGuiFont = 13.0, kCourseHeight = 480.0;
   const double grow = std::clamp(double(height) / kCourseHeight, 1.0, 3.0);
@@ -137,13 +160,7 @@ Panel::~Panel() {
 bool Panel::mouse(int button, int state, int x, int y) {
   if (button == 3 || button == 4) {
     if (state == GLUT_DOWN) ImGui_ImplGLUT_MouseWheelFunc(0, button == 3 ? 1 : -1, x, y);
-  } else if (button >= 0 && button < 3 && state == GLUT_UP && pressUnseen_[button]) {
-    // Released before a frame saw the press (a click under ~20 ms): released after the next.
-    releasePending_[button] = true;
-    releaseX_ = x;
-    releaseY_ = y;
-  } else {
-    if (button >= 0 && button < 3 && state == GLUT_DOWN) pressUnseen_[button] = true;
+  } else if (clicks_.event(button, state == GLUT_DOWN, x, y)) {
     ImGui_ImplGLUT_MouseFunc(button, state, x, y);
   }
   // A release always reaches the viewer too, so that its drags end.
@@ -401,11 +418,8 @@ void Panel::prepare(const Frame& frame, ViewerState& view, SimRunner& runner) {
 
 void Panel::render() {
   ImGui_ImplOpenGL2_RenderDrawData(ImGui::GetDrawData());
-  pressUnseen_.fill(false);  // this frame saw them
-  for (int button = 0; button < 3; ++button) {
-    if (!releasePending_[button]) continue;
-    releasePending_[button] = false;
-    ImGui_ImplGLUT_MouseFunc(button, GLUT_UP, releaseX_, releaseY_);
+  for (const ClickLatch::Release& r : clicks_.frameSeen()) {
+    ImGui_ImplGLUT_MouseFunc(r.button, GLUT_UP, r.x, r.y);
     glutPostRedisplay();  // the next frame sees the release: the click
   }
 }

@@ -49,6 +49,24 @@ float panelFontPixels(int height, double uiScale);
 // scene keeps its size beside it.
 inline constexpr double kPanelColumn = 248.0;  // pixels
 
+// Clicks shorter than a frame (ImGui 1.86 reads a button's state once a frame: a press and its
+// release between two frames were never seen): a release whose press no frame has seen yet is
+// held back, and handed out after the next frame. GL-free, so it is unit-tested.
+class ClickLatch {
+ public:
+  struct Release {
+    int button, x, y;
+  };
+  // A button event (buttons 0-2; others pass): true to forward it now, false when held back.
+  bool event(int button, bool down, int x, int y);
+  // A frame has seen the events forwarded so far: the releases held back, to forward now.
+  std::vector<Release> frameSeen();
+
+ private:
+  std::array<bool, 3> pressUnseen_{}, held_{};
+  std::array<Release, 3> releases_{};
+};
+
 class Panel {
  public:
   // After the GL window exists. `uiScale` (--ui-scale) multiplies the text and spacing.
@@ -109,10 +127,7 @@ class Panel {
   float fontPixels_ = 0.0f;  // the font atlas's size (rebuilt when the window's height asks)
   int width_ = 0;
   bool labelsCut_ = false;
-  // A click shorter than a frame: its release waits for a frame that has seen the press
-  // (ImGui 1.86 reads the button's state once a frame and would miss the click).
-  std::array<bool, 3> pressUnseen_{}, releasePending_{};
-  int releaseX_ = 0, releaseY_ = 0;
+  ClickLatch clicks_;
   void scaleTo(int height);
 };
 
