@@ -25,9 +25,10 @@ $create -o worlds/spinning-k1e4.w --integrator implicit --k-elastic 1e4 --d-elas
 # The showcase (scripts/showcase.sh): dropped spinning (3 rad/s) under gravity onto a spiral
 # ramp (1.5 turns) that winds around a cone (the cone and spiral extensions); with Coulomb
 # friction mu = 0.1, about the ramp's slope at mid-width (pitch / (2 pi r) = 0.15 at r = 1.35 m,
-# 0.11 at its rim), it tumbles and rides the ramp down nearly all the way and comes to rest on
-# its last half-turn (frictionless, it slid off the end and under the ramp, out of sight). At dt
-# 1 ms (friction costs a second contact query a point), RK4 keeps ahead of real time.
+# 0.11 at its rim), it tumbles, rides the ramp down a turn and, under the turn above, slows to a
+# creep (frictionless, it slid off the end and under the ramp, out of sight). At dt 1 ms
+# (friction costs a second contact query a point), RK4 keeps ahead of real time. Its top 2 cm
+# below the box's ceiling: the barrier model needs every point off every solid at the start.
 $create -o worlds/showcase.w --no-plane --field gravity --field-resolution 2 --pose translated \
-  --translate 0.62 0.26 1.0 --velocity 0 0 0 --spin 3 --cone 0 0 0.3 0 0 -1 2.3 0.7 \
+  --translate 0.62 0.26 0.98 --velocity 0 0 0 --spin 3 --cone 0 0 0.3 0 0 -1 2.3 0.7 \
   --spiral 0 0 0.6 0.75 1.95 1.3 1.5 0.25 --friction 0.1 --dt 1e-3

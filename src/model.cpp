@@ -265,13 +265,6 @@ std::optional<StartProblem> Model::startProblem(const State& s) const {
   const double* x = s.x.data();
   if (barrierContact()) {
     for (const auto& o : obstacles_) {
-      if (!o->hasExteriorDistance()) {
-        return StartProblem{"contact",
-                            "the barrier contact model needs each solid's distance "
-                            "outside it, which the " +
-                                std::string(obstacleName(o->kind())) +
-                                " does not have yet (use penalty or smooth)"};
-      }
       for (int p = 0; p < n_; ++p) {
         const double d = o->signedDistance(pointAt(x, n_, p));
         if (!(d > 0.0)) {

@@ -124,8 +124,8 @@ class Model {
   // The largest s in [0, 1] for which no point moving from x along s dx (3n each) reaches a
   // solid (Obstacle::stepBound): the barrier's line-search bound.
   double contactStepBound(const double* x, const double* dx) const;
-  // Why this model cannot step from state s, or nothing: the barrier needs every solid's
-  // exterior distance and every point outside every solid, and every term of the start's
+  // Why this model cannot step from state s, or nothing: the barrier needs every point
+  // outside every solid, and every term of the start's
   // energy must be finite (a cube deep inside a sphere of radius 1e308 would start with an
   // infinite contact energy that the implicit methods then ignore).
   std::optional<StartProblem> startProblem(const State& s) const;

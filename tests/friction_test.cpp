@@ -49,8 +49,8 @@ ModelSpec onePoint(ContactConstants k) {
   return test::onePoint(k);
 }
 
-// A model per solid and law: the walls, the plane, the sphere and the cone (the spiral has no
-// exterior distance for the barrier; its penalty is the cone's code path).
+// A model per solid and law: the walls, the plane, the sphere and the cone (the spiral's
+// friction runs the cone's code path; its exterior distance is checked in contact_laws_test).
 std::vector<ModelSpec> everySolidAndLaw() {
   const ContactConstants laws[] = {{1000.0, 0.3},
                                    {1000.0, 0.3, ContactModel::Smooth, 0.05},

@@ -140,19 +140,18 @@ class Obstacle {
 
   // Writes each contact x has with this solid (at most kMaxPenetrations) to out; returns how
   // many. With reach > 0 also those outside, within reach of the surface: their depth is minus
-  // their exact distance to it (the spiral has none: it has no exterior distance yet).
+  // their distance to it (exact; the spiral's a lower bound, obstacles.h).
   virtual int penetrations(const Vec3& x, double reach, Penetration* out) const = 0;
   int penetrations(const Vec3& x, Penetration* out) const { return penetrations(x, 0.0, out); }
   // How far outside the law reaches: the barrier's dhat, 0 for the others.
   double reach() const { return k_.model == ContactModel::Barrier ? k_.dhat : 0.0; }
   // The signed distance from x to the solid (m): > 0 outside, exact (the walls: to the nearest
-  // wall); -depth inside. The spiral, whose exterior distance is unknown, says +inf outside.
+  // wall; the spiral: a lower bound, obstacles.h); -depth inside.
   virtual double signedDistance(const Vec3& x) const = 0;
-  // False for a solid without an exterior distance (the spiral): the barrier cannot hold it.
-  virtual bool hasExteriorDistance() const { return true; }
   // The largest s in [0, 1] such that x + t dx stays outside the solid for t in [0, s), x
-  // outside: closed form for walls, plane and sphere; conservative advancement on the exact
-  // distance for the cone (within 1e-9 m of the surface); 1 for the spiral.
+  // outside: closed form for walls, plane and sphere; conservative advancement on the distance
+  // for the cone (exact) and the spiral (a lower bound, so no advancement overshoots), within
+  // 1e-9 m of the surface.
   virtual double stepBound(const Vec3& x, const Vec3& dx) const;
 
   // How deep x is inside the solid (m): > 0 in contact, 0 in free space (the walls: the

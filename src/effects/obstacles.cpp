@@ -196,6 +196,106 @@ std::optional<Penetration> spiralPenetration(const Spiral& s, const Vec3& x) {
 
 namespace {
 
+// One face of the spiral seen from outside: e > 0 past it (a lower bound on the distance to
+// it), its gradient and Hessian (row-major).
+struct FaceDistance {
+  double e = -std::numeric_limits<double>::infinity();
+  Vec3 gradient;
+  double hessian[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+};
+
+// r - r0 (sign +1) or r0 - r (sign -1): the distance to the cylinder of radius r0, its gradient
+// sign e_r, its Hessian sign (I - e_r e_r^T - e_z e_z^T) / r.
+FaceDistance cylinderFace(double r, double r0, const Vec3& er, double sign) {
+  FaceDistance f;
+  f.e = sign * (r - r0);
+  f.gradient = er * sign;
+  if (r > 0.0) {
+    const double k = sign / r;
+    f.hessian[0] = f.hessian[4] = k;
+    setOuter(f.hessian, er, er, -k);
+  }
+  return f;
+}
+
+}  // namespace
+
+// Long: the faces of every turn, each a lower bound on its distance, the farthest face of a
+// turn, the nearest turn.
+Penetration spiralExterior(const Spiral& s, const Vec3& x) {
+  const double px = x.x - s.cx, py = x.y - s.cy;
+  const double r = std::hypot(px, py);
+  const double c = s.pitch / (2.0 * std::numbers::pi);
+  const double span = 2.0 * std::numbers::pi * s.turns;
+  // The top and bottom: between two points of a turn at radii >= rm the helicoid's height
+  // changes by c dTheta over a chord of at least (2/pi) rm dTheta (dTheta <= pi), so by at most
+  // G = (pi/2) c / rm times their distance; the vertical gap over sqrt(1 + G^2) is then at most
+  // the distance to the slab. rm = rInner / 2, and nearer the axis than that only the inner
+  // cylinder bounds the distance (it is at least rInner / 2 there).
+  const double rm = 0.5 * s.rInner;
+  const bool slabFaces = rm > 0.0 ? r >= rm : true;
+  const double steepest = rm > 0.0 ? 0.5 * std::numbers::pi * c / rm : 0.0;
+  const double scale = 1.0 / std::sqrt(1.0 + steepest * steepest);
+  double theta = r > 0.0 ? std::atan2(py, px) : 0.0;
+  if (theta < 0.0) theta += 2.0 * std::numbers::pi;
+  const Vec3 er = r > 0.0 ? Vec3{px / r, py / r, 0.0} : Vec3{1.0, 0.0, 0.0};
+  const double r2 = std::max(r * r, 1e-300), r4 = r2 * r2;
+  const Vec3 gt{-py / r2, px / r2, 0.0};  // grad(theta)
+  const double txx = 2.0 * px * py / r4, txy = (py * py - px * px) / r4;
+  const double hTheta[9] = {txx, txy, 0, txy, -txx, 0, 0, 0, 0};
+  FaceDistance nearest;
+  nearest.e = std::numeric_limits<double>::infinity();
+  for (double big = theta - 2.0 * std::numbers::pi; big <= span + 2.0 * std::numbers::pi;
+       big += 2.0 * std::numbers::pi) {
+    FaceDistance farthest;
+    const auto consider = [&](const FaceDistance& f) {
+      if (f.e > farthest.e) farthest = f;
+    };
+    // > 0 above this turn's top; past an end, above the end's (the helicoid continued past
+    // it would sink below the solid's last top and overstate the gap).
+    const double above = x.z - (s.zTop - c * std::clamp(big, 0.0, span));
+    FaceDistance top;
+    top.e = above * scale;
+    const bool along = big > 0.0 && big < span;  // the top's height varies with theta here
+    top.gradient = (gt * (along ? c : 0.0) + Vec3{0.0, 0.0, 1.0}) * scale;
+    for (int i = 0; i < 9; ++i) top.hessian[i] = along ? c * scale * hTheta[i] : 0.0;
+    FaceDistance bottom;
+    bottom.e = (-above - s.thickness) * scale;
+    bottom.gradient = top.gradient * -1.0;
+    for (int i = 0; i < 9; ++i) bottom.hessian[i] = -top.hessian[i];
+    if (slabFaces) {
+      consider(top);
+      consider(bottom);
+    }
+    consider(cylinderFace(r, s.rOuter, er, 1.0));
+    if (s.rInner > 0.0) consider(cylinderFace(r, s.rInner, er, -1.0));
+    // The ends: the half-planes through the axis at Theta = 0 and span. Within a quarter turn
+    // of one, the distance to its plane (linear in x); farther, the distance to the axis.
+    const double before = -big, after = big - span;
+    for (const double past : {before, after}) {
+      if (!(past > 0.0)) continue;
+      if (past < 0.5 * std::numbers::pi) {
+        const double a = past == before ? 0.0 : span;  // the plane's angle
+        const double sign = past == before ? -1.0 : 1.0;
+        FaceDistance end;  // sign (r sin(theta - a)), the signed distance to that plane
+        end.e = sign * (py * std::cos(a) - px * std::sin(a));
+        end.gradient = Vec3{-std::sin(a), std::cos(a), 0.0} * sign;
+        consider(end);
+      } else {
+        consider(cylinderFace(r, 0.0, er, 1.0));
+      }
+    }
+    if (farthest.e < nearest.e) nearest = farthest;
+  }
+  Penetration p;
+  p.depth = -std::max(nearest.e, 0.0);
+  p.gradient = nearest.gradient * -1.0;
+  for (int i = 0; i < 9; ++i) p.hessian[i] = -nearest.hessian[i];
+  return p;
+}
+
+namespace {
+
 // CVODE's root function for the spiral: minus the largest, over the turns Theta = theta + 2 pi k,
 // of the smallest of the six face depths of spiralPenetration (each negative past its face), so
 // > 0 outside, < 0 inside, 0 on the surface, and continuous but on the ray theta = 0 outside
@@ -273,15 +373,14 @@ int ObstacleContact::penetrations(const Vec3& x, double reach, Penetration* out)
     out[0] = *q;
     return 1;
   }
-  if (!(reach > 0.0) || !cone_) return 0;
-  out[0] = coneExterior(*cone_, x);
+  if (!(reach > 0.0)) return 0;
+  out[0] = cone_ ? coneExterior(*cone_, x) : spiralExterior(*spiral_, x);
   return out[0].depth > -reach ? 1 : 0;
 }
 
 double ObstacleContact::signedDistance(const Vec3& x) const {
   if (const std::optional<Penetration> q = penetration(x)) return -q->depth;
-  if (!cone_) return std::numeric_limits<double>::infinity();
-  return -coneExterior(*cone_, x).depth;
+  return -(cone_ ? coneExterior(*cone_, x) : spiralExterior(*spiral_, x)).depth;
 }
 
 double ObstacleContact::depth(const Vec3& x) const {

@@ -27,6 +27,14 @@ std::optional<Penetration> spiralPenetration(const Spiral& spiral, const Vec3& x
 // the apex, r from it) the solid is the triangle (0,0), (H,R), (H,0), and D the distance to its
 // lateral edge or its base edge.
 Penetration coneExterior(const Cone& cone, const Vec3& x);
+// For x outside the spiral ramp: a lower bound D on its distance to the solid, as a penetration
+// of depth -D: per turn the largest of its faces' distances (each a lower bound on the distance
+// to that turn's slab: exact for the cylinders and the end planes, the vertical gap times
+// 1/sqrt(1 + (c/rInner)^2) for the top and bottom, c = pitch / 2 pi), over the turns the
+// least. It is 0 on the surface and the distance itself off a face's middle (to that factor),
+// 1/sqrt(2) of it off an edge; the barrier holds the ramp with it, and, a lower bound,
+// conservative advancement on it never steps a point in.
+Penetration spiralExterior(const Spiral& spiral, const Vec3& x);
 
 // Penalty contact with one of them (src/effects/obstacle.h has what each method answers); all
 // arrays component-major, n points.
@@ -43,7 +51,6 @@ class ObstacleContact final : public Obstacle {
   void addPenaltyJacobian(const double* x, int n, JacobianBlocks& out) const override;
   int penetrations(const Vec3& x, double reach, Penetration* out) const override;
   double signedDistance(const Vec3& x) const override;
-  bool hasExteriorDistance() const override { return cone_.has_value(); }
   // CVODE's roots: the cone's signed distance (continuous, 0 on its surface); the spiral's
   // face depths, max over its turns of their min, negated (obstacles.cpp, spiralRoot).
   int rootsPerPoint() const override { return 1; }
