@@ -38,7 +38,7 @@ def contact_models():
 
 def scenes(tmp, bin_dir):
     """(name, world file, steps, dt or None for the world's): the worlds the table runs. The
-    showcase at 0.01 s: its cube lands on the spiral ramp after 0.35 s and rides it."""
+    showcase at 0.01 s: its cube lands on the ramp after 0.35 s and rides it."""
     course = os.path.join(tmp, "course-k2e4.w")
     subprocess.run([os.path.join(bin_dir, "jello-create-world"), "-o", course,
                     "--k-elastic", "2e4", "--dt", "0.01"], check=True, stdout=subprocess.DEVNULL)
