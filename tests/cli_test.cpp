@@ -575,9 +575,9 @@ TEST(Contact, FlagsChooseTheModelInBothToolsAndBadOnesAreRefused) {
                               "barrier --kappa 500 --stats " +
                               stats.string());
   ASSERT_EQ(barrier.code, 0) << barrier.output;
+  const auto readStats = [&] { return nlohmann::json::parse(test::readFile(stats)); };
   {
-    std::ifstream in(stats);
-    const nlohmann::json j = nlohmann::json::parse(in);
+    const nlohmann::json j = readStats();
     EXPECT_EQ(j["contact"]["model"], "barrier");
     EXPECT_EQ(j["contact"]["dhat_m"].get<double>(), kDefaultBarrierDistance);
     EXPECT_EQ(j["contact"]["kappa_N_per_m"].get<double>(), 500.0);
@@ -590,10 +590,7 @@ TEST(Contact, FlagsChooseTheModelInBothToolsAndBadOnesAreRefused) {
                 "--quiet --stats " + stats.string())
                 .code,
             0);
-  {
-    std::ifstream in(stats);
-    EXPECT_LT(nlohmann::json::parse(in)["min_obstacle_distance_m"].get<double>(), 0.0);
-  }
+  EXPECT_LT(readStats()["min_obstacle_distance_m"].get<double>(), 0.0);
   // The showcase's spiral ramp is held too (it was refused while the spiral had no exterior
   // distance): its cube lands on the ramp within 0.6 s and no point reaches a solid.
   const Outcome spiral = run(sim() + " " + world("showcase.w") +
@@ -601,12 +598,9 @@ TEST(Contact, FlagsChooseTheModelInBothToolsAndBadOnesAreRefused) {
                              "--quiet --stats " +
                              stats.string());
   EXPECT_EQ(spiral.code, 0) << spiral.output;
-  {
-    std::ifstream in(stats);
-    const double least = nlohmann::json::parse(in)["min_obstacle_distance_m"].get<double>();
-    EXPECT_GT(least, 0.0);
-    EXPECT_LT(least, 0.01);  // it came within the barrier's reach
-  }
+  const double least = readStats()["min_obstacle_distance_m"].get<double>();
+  EXPECT_GT(least, 0.0);
+  EXPECT_LT(least, 0.01);  // it came within the barrier's reach
 }
 
 // Friction: --friction MU and --slip-speed in both tools (jello-sim's over the file's), with any

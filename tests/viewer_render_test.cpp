@@ -85,8 +85,7 @@ TEST_F(Frames, TheShadedCubeIsWhereTheCameraProjectsIt) {
   const Viewport viewport{640, 480};
   const Camera camera;
   // The centroid of the cube and the middle of each face seen by the camera: jello red.
-  Vec3 centroid;
-  for (int p = 0; p < s.numPoints(); ++p) centroid += s.position(p) * (1.0 / s.numPoints());
+  const Vec3 centroid = s.centroid();
   const auto c = project(camera, viewport, centroid);
   ASSERT_TRUE(c.has_value());
   const Rgb centre = pixel(image, int(c->x), int(c->y));
@@ -143,8 +142,7 @@ TEST_F(Frames, WireframeAndShadedModesDiffer) {
   // The wireframe's cube is lines: the centroid's neighbourhood is partly background, partly
   // not, and nowhere jello red.
   const State s = initialState(test::loadWorld("jello.w"));
-  Vec3 centroid;
-  for (int p = 0; p < s.numPoints(); ++p) centroid += s.position(p) * (1.0 / s.numPoints());
+  const Vec3 centroid = s.centroid();
   const auto c = project(Camera{}, Viewport{640, 480}, centroid);
   int lines = 0, total = 0;
   for (int dy = -12; dy <= 12; ++dy) {
@@ -163,8 +161,7 @@ TEST_F(Frames, TheTextureChangesTheCubeButNotItsPlaceOrColour) {
   const Image plain = frame("shaded"), textured = frame("textured");
   EXPECT_GT(meanDifference(plain, textured), 0.2);
   const State s = initialState(test::loadWorld("jello.w"));
-  Vec3 centroid;
-  for (int p = 0; p < s.numPoints(); ++p) centroid += s.position(p) * (1.0 / s.numPoints());
+  const Vec3 centroid = s.centroid();
   const auto c = project(Camera{}, Viewport{640, 480}, centroid);
   const Rgb centre = pixel(textured, int(c->x), int(c->y));
   EXPECT_GT(centre.r, 2 * centre.g) << centre.r << " " << centre.g << " " << centre.b;
@@ -228,8 +225,7 @@ TEST(Recording, CompareModeDrawsEachIntegratorInItsOwnPane) {
   // Two panes of 320x480 (less a one-pixel gutter), the same camera: the cube's centroid
   // projects to the same place in each, and both are jello red there.
   const State s = initialState(test::loadWorld("jello.w"));
-  Vec3 centroid;
-  for (int p = 0; p < s.numPoints(); ++p) centroid += s.position(p) * (1.0 / s.numPoints());
+  const Vec3 centroid = s.centroid();
   const auto c = project(Camera{}, Viewport{319, 479}, centroid);
   ASSERT_TRUE(c.has_value());
   for (int pane = 0; pane < 2; ++pane) {
@@ -280,8 +276,7 @@ TEST(Recording, EachComparePaneHasOneCompactHeadsUpLine) {
 TEST_F(Frames, TheFloorIsSolidAndTheCubeCastsAShadowOnIt) {
   const Image image = frame("shaded");
   const State s = initialState(test::loadWorld("jello.w"));
-  Vec3 c;
-  for (int p = 0; p < s.numPoints(); ++p) c += s.position(p) * (1.0 / s.numPoints());
+  const Vec3 c = s.centroid();
   const Vec3 light{0.4, 0.5, 1.0};  // the renderer's key light, towards it
   const Vec3 shadow = c - light * ((c.z + kBoxHalfSize) / light.z);
   const auto under = project(Camera{}, Viewport{640, 480}, shadow);
@@ -353,9 +348,7 @@ TEST(Recording, TheShowcaseKeepsTheCubeInViewInEveryFrame) {
   ASSERT_EQ(r.code, 0) << r.output;
   int fewest = 320 * 240, at = -1;
   for (int i = 0; i < 300; ++i) {
-    char name[16];
-    std::snprintf(name, sizeof name, "%03d.jpg", i);
-    const Image image = readImage(out / name);
+    const Image image = readImage(out / recordedFrameName(i));
     int red = 0;
     for (int y = 0; y < image.height; ++y) {
       for (int x = 0; x < image.width; ++x) {
@@ -381,9 +374,7 @@ TEST(Recording, ThirtyFramesAreThirtyValidChangingJpegs) {
   EXPECT_NE(r.output.find("simulated t = 0 .. 1.933 s"), std::string::npos) << r.output;
   Image previous;
   for (int i = 0; i < 30; ++i) {
-    char name[16];
-    std::snprintf(name, sizeof name, "%03d.jpg", i);
-    const Image image = readImage(out / name);
+    const Image image = readImage(out / recordedFrameName(i));
     EXPECT_EQ(image.width, 640);
     EXPECT_EQ(image.height, 480);
     if (i > 0) {

@@ -1,5 +1,6 @@
 #include "viewer/image_writer.h"
 
+#include <cstdio>
 #include <cstring>
 #include <memory>
 #include <stdexcept>
@@ -50,6 +51,12 @@ void writeJpeg(const std::filesystem::path& path, const Image& image, int qualit
     throw std::runtime_error(path.string() + ": JPEG encoding failed");
   }
   writeFileAtomically(path, bytes);
+}
+
+std::string recordedFrameName(int index) {
+  char name[32];
+  std::snprintf(name, sizeof name, "%03d.jpg", index);
+  return name;
 }
 
 Image readImage(const std::filesystem::path& path) {

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace jello::viewer {
@@ -21,5 +22,8 @@ void writeJpeg(const std::filesystem::path& path, const Image& image, int qualit
 
 // Reads a JPEG back (for tests and checks); throws std::runtime_error on failure.
 Image readImage(const std::filesystem::path& path);
+
+// The file a recording writes frame `index` to (from 0): "000.jpg", "001.jpg", ...
+std::string recordedFrameName(int index);
 
 }  // namespace jello::viewer

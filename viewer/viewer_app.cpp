@@ -185,9 +185,7 @@ void Viewer::recordFrame() {
   const Image image =
       imageFromBottomUp(viewport_.width, viewport_.height, readBackBuffer(viewport_));
   if (!options_.recordDir.empty()) {
-    char name[16];
-    std::snprintf(name, sizeof name, "%03d.jpg", framesDrawn_);
-    writeJpeg(options_.recordDir / name, image);
+    writeJpeg(options_.recordDir / recordedFrameName(framesDrawn_), image);
   }
   if (!options_.recordVideo.empty()) {
     if (!video_) {

@@ -83,9 +83,8 @@ class Viewer {
     recordSpan_ =
         recordedFrameSpan(options.speed, options.courseTime, primary().geometry->frameTime);
     recordStart_ = primary().state.t;
-    if (options.follow) {  // framed from the first frame on
-      view_.follow = true;
-      view_.camera.radius = kFollowRadius;
+    if (options.follow) {  // as key c, framed from the first frame on
+      handleKey(view_, 'c');
       view_.camera.follow(primary().state.centroid(), 1.0);
     }
   }

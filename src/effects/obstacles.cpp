@@ -271,16 +271,17 @@ Penetration spiralExterior(const Spiral& s, const Vec3& x) {
     if (s.rInner > 0.0) consider(cylinderFace(r, s.rInner, er, -1.0));
     // The ends: the half-planes through the axis at Theta = 0 and span. Within a quarter turn
     // of one, the distance to its plane (linear in x); farther, the distance to the axis.
-    const double before = -big, after = big - span;
-    for (const double past : {before, after}) {
-      if (!(past > 0.0)) continue;
-      if (past < 0.5 * std::numbers::pi) {
-        const double a = past == before ? 0.0 : span;  // the plane's angle
-        const double sign = past == before ? -1.0 : 1.0;
-        FaceDistance end;  // sign (r sin(theta - a)), the signed distance to that plane
-        end.e = sign * (py * std::cos(a) - px * std::sin(a));
-        end.gradient = Vec3{-std::sin(a), std::cos(a), 0.0} * sign;
-        consider(end);
+    struct End {
+      double past, angle, sign;  // how far past it, the plane's angle, its outward side
+    };
+    for (const End& end : {End{-big, 0.0, -1.0}, End{big - span, span, 1.0}}) {
+      if (!(end.past > 0.0)) continue;
+      if (end.past < 0.5 * std::numbers::pi) {
+        FaceDistance f;  // sign r sin(theta - angle): the signed distance to that plane
+        const double ca = std::cos(end.angle), sa = std::sin(end.angle);
+        f.e = end.sign * (py * ca - px * sa);
+        f.gradient = Vec3{-sa, ca, 0.0} * end.sign;
+        consider(f);
       } else {
         consider(cylinderFace(r, 0.0, er, 1.0));
       }

@@ -29,11 +29,12 @@ std::optional<Penetration> spiralPenetration(const Spiral& spiral, const Vec3& x
 Penetration coneExterior(const Cone& cone, const Vec3& x);
 // For x outside the spiral ramp: a lower bound D on its distance to the solid, as a penetration
 // of depth -D: per turn the largest of its faces' distances (each a lower bound on the distance
-// to that turn's slab: exact for the cylinders and the end planes, the vertical gap times
-// 1/sqrt(1 + (c/rInner)^2) for the top and bottom, c = pitch / 2 pi), over the turns the
-// least. It is 0 on the surface and the distance itself off a face's middle (to that factor),
-// 1/sqrt(2) of it off an edge; the barrier holds the ramp with it, and, a lower bound,
-// conservative advancement on it never steps a point in.
+// to that turn's slab: exact for the cylinders and the end planes, the vertical gap over
+// sqrt(1 + G^2) for the top and bottom, G = (pi/2) c / (rInner/2) bounding the helicoid's slope
+// along any chord, c = pitch / 2 pi), over the turns the least. It is 0 on the surface and the
+// distance itself off a face's middle (to that factor), 1/sqrt(2) of it off an edge; the barrier
+// holds the ramp with it, and, a lower bound, conservative advancement on it never steps a point
+// in.
 Penetration spiralExterior(const Spiral& spiral, const Vec3& x);
 
 // Penalty contact with one of them (src/effects/obstacle.h has what each method answers); all
