@@ -75,15 +75,18 @@ def table(path=JSON):
                 extra = (f"{b['newton_iterations_per_step']:.1f} Newton/step"
                          if "newton_iterations_per_step" in b else
                          f"{plural(b.get('factorizations', 0), 'factorization')}, "
-                         f"{plural(b.get('factor_updates', 0), 'update')}")
+                         f"{plural(b.get('factor_updates', 0), 'update')}, "
+                         f"{plural(b.get('coarse_corrections', 0), 'coarse correction')}")
                 cells.append(f"{ms:.3g} ms ({extra})")
             lines.append(f"| `{integrator}` | {n}^3 | " + " | ".join(cells) + " |")
     ctx = data["context"]
     lines.append("")
     lines.append(f"Wall time per step over jello.w's first 30 steps at dt = 0.01 s (its cube "
                  f"meets the walls and the plane), after the first; in parentheses Newton's "
-                 f"iterations per step, or projective's factorizations and rank updates over the "
-                 f"run (`scripts/contact-speed.py --run`, one core of the native build, "
+                 f"iterations per step, or projective's factorizations, rank updates and "
+                 f"coarse-corrected solves over the run (light contacts leave its factor alone: "
+                 f"solvers/README.md) "
+                 f"(`scripts/contact-speed.py --run`, one core of the native build, "
                  f"{ctx['date'][:10]}; experiments/results/contact_speed.json).")
     return "\n".join(lines)
 

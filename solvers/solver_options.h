@@ -63,7 +63,8 @@ struct CvodeOptions {
   double atolVelocity = 0.0;
   int maxOrder = 5;  // order limit, 1..5 (BDF 3..5 are not A-stable)
   // Contact onset and release located as roots of the penetration depths (walls, plane,
-  // sphere): CVODE stops there and restarts, instead of stepping over the force's kink.
+  // sphere, cone, spiral): CVODE stops there and restarts, instead of stepping over the
+  // penalty's kink (smooth and barrier contact have none to step over).
   bool contactRoots = false;
   bool stabilityLimitDetection = true;
   double maxStep = 0.0;  // s, 0: no limit; else within kMinMaxStep..kMaxMaxStep
@@ -108,6 +109,11 @@ struct ProjectiveOptions {
   // of the contact set, restarts it.
   double chebyshevRho = 0.0;
   int chebyshevDelay = 2;
+  // Coarse correction of contacts the factor misses (solvers/system/lattice_coarse_space.h):
+  // on a lattice's points, g^3 coarse nodes (g = coarseNodes; 0: off, the factor then follows
+  // every contact). A contact whose weight is under kCoarseWeightRatio of its point's diagonal
+  // leaves the factor as it is, and each global solve is corrected on the coarse nodes.
+  int coarseNodes = 4;
 };
 
 struct SolverOptions {

@@ -14,6 +14,7 @@ ModelSpec modelSpecFromWorld(const World& world) {
   ModelSpec spec;
   const Lattice lattice{world.cubeResolution};
   spec.numPoints = lattice.numPoints();
+  spec.latticeResolution = lattice.n;
   spec.mass = world.mass;
   spec.springs = latticeSpringGroups(lattice, world.kElastic, world.dElastic);
   spec.contact = {world.kCollision,    world.dCollision,       world.contact.model,
@@ -34,9 +35,12 @@ std::atomic<long> nextModelId{0};
 Model::Model(ModelSpec spec)
     : id_(nextModelId.fetch_add(1, std::memory_order_relaxed)),
       n_(spec.numPoints),
+      latticeResolution_(spec.latticeResolution),
       mass_(spec.mass),
       springs_(std::move(spec.springs), spec.numPoints) {
   JELLO_ASSERT(n_ > 0 && mass_ > 0.0, "a model has points of positive mass");
+  JELLO_ASSERT(latticeResolution_ == 0 || Lattice{latticeResolution_}.numPoints() == n_,
+               "a lattice model has resolution^3 points");
   // In the obstacle table's order (src/effects/obstacle.h).
   if (spec.walls) obstacles_.push_back(std::make_unique<WallContact>(spec.contact));
   if (spec.plane) obstacles_.push_back(std::make_unique<PlaneContact>(*spec.plane, spec.contact));

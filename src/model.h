@@ -28,6 +28,9 @@ namespace jello {
 
 struct ModelSpec {
   int numPoints = 0;
+  // Points per edge when the points are a Lattice's, in its order (src/world/lattice.h); 0 when
+  // they are not (a test's few points). Solvers may use the lattice's structure.
+  int latticeResolution = 0;
   double mass = 0.0;  // kg, of each point
   std::vector<SpringGroup> springs;
   bool walls = true;
@@ -87,6 +90,7 @@ class Model {
   // integrators bind to a model by it, never by its address, which a new model may reuse.
   long id() const { return id_; }
   double mass() const { return mass_; }
+  int latticeResolution() const { return latticeResolution_; }  // ModelSpec's
 
   // f = total force (N) at state (x, v); all arrays 3n, component-major. The model keeps no
   // scratch: several threads may evaluate one model at once (only its counters change, and
@@ -217,6 +221,7 @@ class Model {
 
   long id_;
   int n_;
+  int latticeResolution_;
   double mass_;
   SpringForces springs_;
   std::vector<std::unique_ptr<Obstacle>> obstacles_;

@@ -33,8 +33,7 @@ State backwardEulerStep(const Model& model, const State& start, double h) {
 }
 
 State projectiveStep(const Model& model, const State& start, double h, int iterations,
-                     double chebyshevRho = 0.0) {
-  ProjectiveOptions o;
+                     double chebyshevRho = 0.0, ProjectiveOptions o = {}) {
   o.iterations = iterations;
   o.chebyshevRho = chebyshevRho;
   ProjectiveIntegrator pd(o);
@@ -42,6 +41,11 @@ State projectiveStep(const Model& model, const State& start, double h, int itera
   EXPECT_TRUE(pd.step(model, s, h).ok);
   // Every iteration is done, unless one reached the fixed point exactly (an update of 0 stops
   // them at the default tolerance 0: Chebyshev through contact did at 75 of 300 under ASan).
+  // With a tolerance, the iterations reach it.
+  if (o.tolerance > 0.0) {
+    EXPECT_LE(pd.lastUpdate(), o.tolerance);
+    return s;
+  }
   EXPECT_TRUE(pd.lastIterations() == iterations || pd.lastUpdate() == 0.0)
       << pd.lastIterations() << " of " << iterations << " iterations, the last moving "
       << pd.lastUpdate() << " m";
@@ -210,10 +214,13 @@ TEST(Projective, FactorsOncePerSceneAndStepSizeAndAgainOnContactChanges) {
   ASSERT_TRUE(pd.step(other, s, 0.005).ok);
   EXPECT_EQ(pd.refactorizations(), 3);
 
-  // Thrown onto the floor: the contact set changes, and each change refactors.
+  // Thrown onto the floor: the contact set changes, and each change refactors when the factor
+  // follows every contact (without the coarse correction: the path of contacts too stiff for it).
   World w = test::loadWorld("jello.w");
   const Model wall(w);
-  ProjectiveIntegrator thrown;
+  ProjectiveOptions exact;
+  exact.coarseNodes = 0;
+  ProjectiveIntegrator thrown(exact);
   State t = initialState(w);
   const int n = t.numPoints();
   for (int p = 0; p < n; ++p) t.v[2 * n + p] = -20.0;
@@ -233,7 +240,7 @@ TEST(Projective, FactorsOncePerSceneAndStepSizeAndAgainOnContactChanges) {
   // Most changes are a few points: rank-one updates of the factor (cholmod_updown), which take
   // the same steps as factoring afresh every time, to round-off.
   EXPECT_GE(updates, 1.0);
-  ProjectiveOptions refactorOnly;
+  ProjectiveOptions refactorOnly = exact;
   refactorOnly.updateFactors = false;
   ProjectiveIntegrator fresh(refactorOnly);
   State u = initialState(w);
@@ -257,6 +264,7 @@ TEST(Projective, CoveringContactWeightsTakeTheSameStepsWithFewerFactorChanges) {
     options.iterations = 2000;
     options.tolerance = 1e-11;
     options.coverContacts = cover;
+    options.coarseNodes = 0;  // the factor alone covers or follows the contacts
     ProjectiveIntegrator pd(options);
     State s = initialState(w);
     const int n = s.numPoints();
@@ -280,6 +288,107 @@ TEST(Projective, CoveringContactWeightsTakeTheSameStepsWithFewerFactorChanges) {
   EXPECT_LT(apart, 1e-7);
   const int n = a.numPoints();
   EXPECT_GT(a.x.segment(2 * n, n).minCoeff(), -2.05);  // the floor holds
+}
+
+// jello.w's contacts are light: kc = 400 N/m against a point's diagonal of m/h^2 and its
+// springs' stiffness (about 2,000 to 5,000 N/m at h = 0.01). The factor stays that of
+// M/h^2 + L, each global solve is corrected on 4^3 coarse nodes (solvers/system/
+// lattice_coarse_space.h), and the steps are backward Euler's as before: iterated to the fixed
+// point, the same steps as a factor that follows every contact; at ten iterations as close to
+// backward Euler as it.
+TEST(Projective, LightContactsLeaveTheFactorToTheCoarseCorrection) {
+  // Smooth contact: the penalty's kink leaves some steps unconverged either way.
+  World w = test::loadWorld("jello.w");
+  w.contact.model = ContactModel::Smooth;
+  w.contact.layer = kDefaultContactLayer;
+  const Model model(w);
+  const auto thrown = [&](ProjectiveOptions o, std::map<std::string, double>* stats,
+                          double* deepest) {
+    ProjectiveIntegrator pd(o);
+    State s = initialState(w);
+    const int n = s.numPoints();
+    for (int p = 0; p < n; ++p) s.v[2 * n + p] = -20.0;
+    for (int i = 0; i < 30; ++i) {
+      EXPECT_TRUE(pd.step(model, s, 0.01).ok);
+      *deepest = std::max(*deepest, -2.0 - s.x.segment(2 * n, n).minCoeff());
+    }
+    for (const Statistic& st : pd.statistics()) (*stats)[st.name] = st.value;
+    return s;
+  };
+  std::map<std::string, double> stats, exactStats;
+  double deepest = 0.0, deepestExact = 0.0;
+  ProjectiveOptions converged;
+  converged.iterations = 3000;
+  converged.tolerance = 1e-12;
+  ProjectiveOptions convergedExact = converged;
+  convergedExact.coarseNodes = 0;
+  const State a = thrown(converged, &stats, &deepest);
+  const State b = thrown(convergedExact, &exactStats, &deepestExact);
+  const double moved = (a.x - initialState(w).x).cwiseAbs().maxCoeff();
+  const double apart = (a.x - b.x).cwiseAbs().maxCoeff();
+  std::printf(
+      "thrown at the floor, converged: %.3g m apart after moving %.3g m; %g corrected "
+      "solves\n",
+      apart, moved, stats.at("coarse_corrections"));
+  EXPECT_LT(apart, 1e-8 * moved);
+  EXPECT_EQ(stats.at("factorizations"), 1.0);
+  EXPECT_EQ(stats.at("factor_updates"), 0.0);
+  EXPECT_EQ(stats.at("contact_set_changes"), 0.0);
+  EXPECT_GT(stats.at("coarse_corrections"), 30.0);
+  EXPECT_GT(exactStats.at("factor_updates") + exactStats.at("factorizations"), 10.0);
+  // Ten iterations: the floor holds it as well.
+  stats.clear();
+  deepest = 0.0;
+  (void)thrown(ProjectiveOptions{}, &stats, &deepest);
+  EXPECT_EQ(stats.at("factorizations"), 1.0);
+  EXPECT_LT(deepest, 0.05);
+  // And each step of ten iterations is as close to the fixed point as with the factor following
+  // every contact: from each state of the throw, the error relative to the step.
+  ProjectiveOptions following;
+  following.coarseNodes = 0;
+  ProjectiveIntegrator driver;
+  State s = initialState(w);
+  const int n = s.numPoints();
+  for (int p = 0; p < n; ++p) s.v[2 * n + p] = -20.0;
+  double worst[2] = {0.0, 0.0}, sum[2] = {0.0, 0.0};
+  for (int i = 0; i < 30; ++i) {
+    const State fixedPoint = projectiveStep(model, s, 0.01, 3000, 0.0, convergedExact);
+    for (int k = 0; k < 2; ++k) {
+      const State t = projectiveStep(model, s, 0.01, 10, 0.0, k ? following : ProjectiveOptions{});
+      const double e = relativeStepError(s, fixedPoint, t);
+      worst[k] = std::max(worst[k], e);
+      sum[k] += e;
+    }
+    ASSERT_TRUE(driver.step(model, s, 0.01).ok);
+  }
+  std::printf(
+      "10 iterations from each state of the throw: worst %.4g, mean %.4g of the step "
+      "(following every contact: %.4g, %.4g)\n",
+      worst[0], sum[0] / 30, worst[1], sum[1] / 30);
+  EXPECT_LE(worst[0], 1.1 * worst[1]);
+  EXPECT_LE(sum[0], 1.1 * sum[1]);
+}
+
+// Contact as stiff as kc = 1e5 N/m outweighs a point's diagonal: such weights go into the factor
+// (updates or a new factorization) and the coarse correction takes only the light ones.
+TEST(Projective, HeavyContactsStillEnterTheFactor) {
+  World w = test::loadWorld("jello.w");
+  w.kCollision = 1e5;
+  const Model model(w);
+  ProjectiveIntegrator pd;
+  State s = initialState(w);
+  const int n = s.numPoints();
+  for (int p = 0; p < n; ++p) s.v[2 * n + p] = -5.0;
+  double deepest = 0.0;
+  for (int i = 0; i < 30; ++i) {
+    ASSERT_TRUE(pd.step(model, s, 0.01).ok);
+    deepest = std::max(deepest, -2.0 - s.x.segment(2 * n, n).minCoeff());
+  }
+  std::map<std::string, double> stats;
+  for (const Statistic& st : pd.statistics()) stats[st.name] = st.value;
+  EXPECT_GE(stats.at("contact_set_changes"), 1.0);
+  EXPECT_GE(stats.at("factor_updates") + stats.at("factorizations"), 2.0);
+  EXPECT_LT(deepest, 0.01);
 }
 
 // At 10^3 points and up the factor is solved in single precision and contact changes become a
@@ -308,6 +417,7 @@ TEST(Projective, LargeFactorsTakeContactChangesAsACorrectionWithTheSameSteps) {
   converged.iterations = 60;
   converged.chebyshevRho = 0.85;
   converged.tolerance = 1e-11;
+  converged.coarseNodes = 0;  // every contact change goes to the factor
   double deepest = 0.0, deepestFresh = 0.0;
   const auto [corrected, stats] = thrownAtTheFloor(converged, &deepest);
   ProjectiveOptions refactorOnly = converged;

@@ -22,7 +22,8 @@
 //                               per step over steps 2-30 (manual time; the first, with the
 //                               set-up, left out); counters: Newton iterations per step,
 //                               unconverged steps, factorizations, factor updates, contact-set
-//                               changes, barrier cuts (scripts/contact-speed.py)
+//                               changes, barrier cuts, coarse corrections
+//                               (scripts/contact-speed.py)
 //   BM_Crossover/<method>/E     1 simulated second of the spinning stretched cube at k = 10^E
 //                               with damping 0.25 (8^3): projective at dt = 1/60, implicit and
 //                               bdf2 at dt = 0.01 (also in fastNewton's configuration), RK4 at
@@ -256,9 +257,10 @@ void BM_ContactRun(benchmark::State& st, IntegratorKind kind, ContactModel model
     stats = sim.integrator().statistics();
   }
   for (const Statistic& s : stats) {
-    for (const char* name : {"newton_iterations_per_step", "newton_unconverged_steps",
-                             "factorizations", "factor_updates", "contact_set_changes",
-                             "barrier_cuts", "factor_time_s", "solve_time_s"}) {
+    for (const char* name :
+         {"newton_iterations_per_step", "newton_unconverged_steps", "factorizations",
+          "factor_updates", "contact_set_changes", "barrier_cuts", "coarse_corrections",
+          "factor_time_s", "solve_time_s"}) {
       if (s.name == name) st.counters[name] = s.value;
     }
   }

@@ -13,7 +13,8 @@
 // relative tolerance does not depend on where the scene is), with separate absolute
 // tolerances for positions and velocities (CVodeSVtolerances). With contactRoots, the
 // penetration depths (walls: 2 - |x_i| per coordinate; plane: signed distance; sphere:
-// distance - R) are CVODE root functions: it stops where a contact begins or ends, and is
+// distance - R; cone: signed distance; spiral: its face depths, src/effects/obstacles.h) are
+// CVODE root functions: it stops where a contact begins or ends, and is
 // restarted there (CVodeReInit), as the force's derivative jumps.
 #pragma once
 

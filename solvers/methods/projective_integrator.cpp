@@ -72,6 +72,12 @@ void ProjectiveIntegrator::bind(const Model& model) {
     weights_[c].setZero(n_);
     wanted_[c].setZero(n_);
     factoredWeights_[c].setZero(n_);
+    coarseWeights_[c].setZero(n_);
+  }
+  coarse_.reset();
+  const int resolution = model.latticeResolution();
+  if (options_.coarseNodes >= 2 && resolution >= options_.coarseNodes) {
+    coarse_ = std::make_unique<LatticeCoarseSpace>(resolution, options_.coarseNodes);
   }
   factored_ = false;
 }
@@ -98,22 +104,54 @@ void ProjectiveIntegrator::chooseDamping(const Model& model, double h) {
 }
 
 long ProjectiveIntegrator::contactWeights(const Model& model, const double* x, std::ptrdiff_t lo,
-                                          std::ptrdiff_t hi) {
+                                          std::ptrdiff_t hi, long* light) {
   // Each obstacle's stiffness per contact spring, on the coordinates it reaches.
   const std::array<double*, 3> w{wanted_[0].data(), wanted_[1].data(), wanted_[2].data()};
   weightsAt(model, x, lo, hi, w);
-  // The weights above the factor's (covering) or different from them (exact).
-  long count = 0;
+  // The weights above the factor's (covering) or different from them (exact); with the coarse
+  // correction, different by more than it takes.
+  long count = 0, others = 0;
   const bool exact = !options_.coverContacts;
   for (int c = 0; c < 3; ++c) {
     const double* wc = w[c];
     const double* factored = factoredWeights_[factorOf_[c]].data();
+    if (coarse_) {
+      const double* diagonal = freeDiagonal_.data();
+#pragma omp simd reduction(+ : count, others)
+      for (std::ptrdiff_t p = lo; p < hi; ++p) {
+        const double change = std::abs(wc[p] - factored[p]);
+        const long heavy = long(change > kLightContactRatio * diagonal[p]);
+        count += heavy;
+        others += long(change != 0.0) - heavy;
+      }
+    } else {
 #pragma omp simd reduction(+ : count)
-    for (std::ptrdiff_t p = lo; p < hi; ++p) {
-      count += long(wc[p] > factored[p]) + long(exact && wc[p] < factored[p]);
+      for (std::ptrdiff_t p = lo; p < hi; ++p) {
+        count += long(wc[p] > factored[p]) + long(exact && wc[p] < factored[p]);
+      }
     }
   }
+  *light += others;
   return count;
+}
+
+StepResult ProjectiveIntegrator::correctOnCoarseNodes() {
+  for (int c = 0; c < 3; ++c) {
+    const Eigen::VectorXd& factored = factoredWeights_[factorOf_[c]];
+    difference_ = wanted_[c] - factored;
+    if (difference_.isZero(0.0)) continue;
+    if (!coarseFactored_[c] || coarseWeights_[c] != wanted_[c]) {
+      coarseFactored_[c] = false;
+      if (StepResult res = coarse_->factor(wanted_[c].data(), coarseFactors_[c]); !res.ok) {
+        return res.within("projective coarse correction");
+      }
+      coarseWeights_[c] = wanted_[c];
+      coarseFactored_[c] = true;
+    }
+    coarse_->correct(coarseFactors_[c], difference_.data(), delta_.col(c).data());
+  }
+  ++coarseCorrections_;
+  return StepResult::success();
 }
 
 bool ProjectiveIntegrator::planWeights(const Model& model, const double* x0, const double* v0,
@@ -153,6 +191,13 @@ bool ProjectiveIntegrator::planWeights(const Model& model, const double* x0, con
 StepResult ProjectiveIntegrator::factorChanged(double h) {
   const bool all = !factored_ || h != h_;
   const double inertia = mass_ / (h * h);
+  if (all && coarse_) {
+    // The coarse space's base and the diagonal a contact's weight is weighed against.
+    laplacian_->form(inertia, dampingRate_, 1.0, nullptr, free_);
+    coarse_->setBase(free_);
+    freeDiagonal_ = free_.diagonal();
+    coarseFactored_.fill(false);
+  }
   for (int c = 0; c < 3; ++c) {
     // A coordinate whose matrix equals an earlier one's shares its factor.
     int same = c;
@@ -263,15 +308,22 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
     // v = (x - x0)/h); on each block of points once its forces are final, the global step's
     // right-hand side -r = f - M (x - y)/h^2 and the contact weights at x, in the same pass.
     std::atomic<long> uncovered{0};  // weights above those of the factor its coordinate uses
+    std::atomic<long> light{0};      // the coarse correction's
+    if (coarse_ && (!factored_ || h != h_)) {
+      // The factor for h before the first weights: they are weighed against its diagonal.
+      if (StepResult res = factorChanged(h); !res.ok) return res;
+    }
     model.forces(x, v, f_.data(), [&](std::ptrdiff_t lo, std::ptrdiff_t hi) {
       for (std::ptrdiff_t c = 0; c < 3; ++c) {
         for (std::ptrdiff_t i = c * n + lo; i < c * n + hi; ++i) {
           d[i] = f[i] - inertia * (x[i] - y[i]);
         }
       }
-      if (const long count = contactWeights(model, x, lo, hi)) {
+      long others = 0;
+      if (const long count = contactWeights(model, x, lo, hi, &others)) {
         uncovered.fetch_add(count, std::memory_order_relaxed);
       }
+      if (others) light.fetch_add(others, std::memory_order_relaxed);
     });
     // A point touched that the factor does not cover: its weight joins (the others stay).
     const long missed = uncovered.load(std::memory_order_relaxed);
@@ -302,6 +354,9 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
       c += columns;
     }
     if (!solved.ok) return solved;
+    if (coarse_ && light.load(std::memory_order_relaxed) > 0 && !changed) {
+      if (StepResult res = correctOnCoarseNodes(); !res.ok) return res;
+    }
     solveSeconds_ += secondsSince(start);
     if (options_.chebyshevRho > 0.0) {
       // A new contact set is a new iteration matrix: the Chebyshev run starts again.
@@ -358,6 +413,7 @@ std::vector<Statistic> ProjectiveIntegrator::statistics() const {
       {"factorizations", static_cast<double>(factorizations_)},
       {"contact_set_changes", static_cast<double>(contactChanges_)},
       {"barrier_cuts", static_cast<double>(barrierCuts_)},
+      {"coarse_corrections", static_cast<double>(coarseCorrections_)},
       {"factor_updates", static_cast<double>(updates_)},
       {"factor_time_s", factorSeconds_},
       {"chebyshev_restarts", static_cast<double>(chebyshev_.restarts())},

@@ -24,7 +24,14 @@
 // it misses, and keeps the weights of points that left until they outnumber the wanted ones. A is
 // factored with CHOLMOD once per scene and step size, and again only for a coordinate whose weights
 // changed (a change of a few points by CHOLMOD's rank-one updates and downdates of the factor,
-// cholmod_updown); the factor is shared between coordinates whose matrices are equal. Spring and
+// cholmod_updown); the factor is shared between coordinates whose matrices are equal. On a
+// lattice (ProjectiveOptions::coarseNodes), a light contact, whose weight is under half its
+// point's diagonal of M/h^2 + L (jello.w's kc 400 against 2,000 N/m and more), leaves the factor
+// alone: each global solve is corrected on 4^3 coarse nodes for the weights the factor lacks or
+// holds stale (solvers/system/lattice_coarse_space.h), which is where a missed contact is stiff
+// (a face pressed against the whole cube's inertia); heavy ones go into the factor as above, and
+// contact_set_changes counts only those. On jello.w at 16^3 one factorization serves the run.
+// Spring and
 // contact damping, the force field and the user force are evaluated at the iterate (lagged one
 // iteration): at the fixed point they are exactly where backward Euler evaluates them, so the
 // iterations converge to the `implicit` step, damping included. The lag converges while the
@@ -48,6 +55,7 @@
 #include "solvers/integrator.h"
 #include "solvers/linalg/chebyshev_weights.h"
 #include "solvers/system/jacobian.h"
+#include "solvers/system/lattice_coarse_space.h"
 
 namespace jello {
 
@@ -79,8 +87,13 @@ class ProjectiveIntegrator final : public Integrator {
   // alone converges (0), from the damping's share of A's diagonal.
   void chooseDamping(const Model& model, double h);
   // The contact weights at x into wanted_ for the points [lo, hi); the number above the weights
-  // of the factor their coordinate uses (ProjectiveOptions::coverContacts; off: different).
-  long contactWeights(const Model& model, const double* x, std::ptrdiff_t lo, std::ptrdiff_t hi);
+  // of the factor their coordinate uses (ProjectiveOptions::coverContacts; off: different; with
+  // the coarse correction, only by more than it takes: heavy). *light counts the others.
+  long contactWeights(const Model& model, const double* x, std::ptrdiff_t lo, std::ptrdiff_t hi,
+                      long* light);
+  // The coarse correction of each coordinate's update (delta_) for the weights it wants but
+  // its factor lacks (ProjectiveOptions::coarseNodes).
+  StepResult correctOnCoarseNodes();
   // The weights for a step from x0 at velocity v0 into weights_; true when they differ from
   // the factored ones (a point about to touch is not covered, or stale weights are dropped).
   bool planWeights(const Model& model, const double* x0, const double* v0, double h);
@@ -107,6 +120,15 @@ class ProjectiveIntegrator final : public Integrator {
   int lastIterations_ = 0;
   double lastUpdate_ = 0.0;
   std::vector<std::pair<int, double>> changes_;  // a coordinate's changed contact weights
+  // The coarse correction (coarseNodes): its space, A's diagonal without contact weights (which
+  // weight a contact may leave to it), and per coordinate the weights its coarse factor has.
+  std::unique_ptr<LatticeCoarseSpace> coarse_;
+  SparseMatrix free_;  // M/h^2 + L (+ L_c/h), the coarse space's base
+  Eigen::VectorXd freeDiagonal_, difference_;
+  std::array<LatticeCoarseSpace::Factor, 3> coarseFactors_;
+  std::array<Eigen::VectorXd, 3> coarseWeights_;
+  std::array<bool, 3> coarseFactored_{};
+  long coarseCorrections_ = 0;
   long steps_ = 0, iterations_ = 0, factorizations_ = 0, contactChanges_ = 0, updates_ = 0;
   long barrierCuts_ = 0;  // updates cut short by the barrier
   double factorSeconds_ = 0.0, solveSeconds_ = 0.0;

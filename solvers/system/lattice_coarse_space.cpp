@@ -1,0 +1,103 @@
+#include "solvers/system/lattice_coarse_space.h"
+
+#include <algorithm>
+
+#include "src/base/assertions.h"
+#include "src/world/lattice.h"
+
+namespace jello {
+
+LatticeCoarseSpace::LatticeCoarseSpace(int resolution, int nodes) {
+  JELLO_ASSERT(resolution >= 2 && nodes >= 2 && nodes <= resolution,
+               "a coarse space has 2 to resolution nodes per edge");
+  const Lattice lattice{resolution};
+  n_ = lattice.numPoints();
+  node_.resize(8 * std::size_t(n_));
+  weight_.resize(8 * std::size_t(n_));
+  // Each lattice index's coarse cell and its place in it.
+  const double scale = double(nodes - 1) / (resolution - 1);
+  std::vector<int> cell(resolution);
+  std::vector<double> place(resolution);
+  for (int i = 0; i < resolution; ++i) {
+    const double t = i * scale;
+    cell[i] = std::min(static_cast<int>(t), nodes - 2);
+    place[i] = t - cell[i];
+  }
+  for (int i = 0; i < resolution; ++i)
+    for (int j = 0; j < resolution; ++j)
+      for (int k = 0; k < resolution; ++k) {
+        const std::size_t p = 8 * std::size_t(lattice.index(i, j, k));
+        int corner = 0;
+        for (int di = 0; di < 2; ++di)
+          for (int dj = 0; dj < 2; ++dj)
+            for (int dk = 0; dk < 2; ++dk, ++corner) {
+              node_[p + corner] = ((cell[i] + di) * nodes + cell[j] + dj) * nodes + cell[k] + dk;
+              weight_[p + corner] = (di ? place[i] : 1.0 - place[i]) *
+                                    (dj ? place[j] : 1.0 - place[j]) *
+                                    (dk ? place[k] : 1.0 - place[k]);
+            }
+      }
+  const int size = nodes * nodes * nodes;
+  base_.setZero(size, size);
+  g_.setZero(size);
+}
+
+void LatticeCoarseSpace::setBase(const SparseMatrix& S) {
+  JELLO_ASSERT(S.rows() == n_ && S.cols() == n_, "the coarse space's matrix has its points");
+  base_.setZero();
+  for (int j = 0; j < n_; ++j) {
+    const int* nj = &node_[8 * std::size_t(j)];
+    const double* wj = &weight_[8 * std::size_t(j)];
+    for (SparseMatrix::InnerIterator it(S, j); it; ++it) {
+      const int* ni = &node_[8 * std::size_t(it.row())];
+      const double* wi = &weight_[8 * std::size_t(it.row())];
+      for (int b = 0; b < 8; ++b) {
+        const double s = it.value() * wj[b];
+        for (int a = 0; a < 8; ++a) base_(ni[a], nj[b]) += s * wi[a];
+      }
+    }
+  }
+}
+
+StepResult LatticeCoarseSpace::factor(const double* w, Factor& out) {
+  work_ = base_;
+  for (int p = 0; p < n_; ++p) {
+    if (w[p] == 0.0) continue;
+    const int* np = &node_[8 * std::size_t(p)];
+    const double* wp = &weight_[8 * std::size_t(p)];
+    for (int b = 0; b < 8; ++b) {
+      const double s = w[p] * wp[b];
+      for (int a = 0; a < 8; ++a) work_(np[a], np[b]) += s * wp[a];
+    }
+  }
+  out.llt.compute(work_);
+  if (out.llt.info() != Eigen::Success) {
+    return StepResult::failure("the coarse correction's matrix is not positive definite");
+  }
+  return StepResult::success();
+}
+
+void LatticeCoarseSpace::correct(const Factor& f, const double* d, double* delta) const {
+  g_.setZero();
+  for (int p = 0; p < n_; ++p) {
+    if (d[p] == 0.0) continue;
+    const double r = d[p] * delta[p];
+    const int* np = &node_[8 * std::size_t(p)];
+    const double* wp = &weight_[8 * std::size_t(p)];
+    for (int a = 0; a < 8; ++a) g_[np[a]] -= r * wp[a];
+  }
+  f.llt.solveInPlace(g_);
+  prolong(g_.data(), delta);
+}
+
+void LatticeCoarseSpace::prolong(const double* c, double* x) const {
+  for (int p = 0; p < n_; ++p) {
+    const int* np = &node_[8 * std::size_t(p)];
+    const double* wp = &weight_[8 * std::size_t(p)];
+    double sum = 0.0;
+    for (int a = 0; a < 8; ++a) sum += wp[a] * c[np[a]];
+    x[p] += sum;
+  }
+}
+
+}  // namespace jello

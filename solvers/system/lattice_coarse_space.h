@@ -1,0 +1,62 @@
+// A coarse space for the points of a lattice (src/world/lattice.h): trilinear hat functions of
+// the points' lattice indices on g^3 coarse nodes, P (n x g^3, eight entries a row), and the
+// Galerkin correction through it of a solve with a matrix that differs from the wanted one on
+// the diagonal. Projective dynamics keeps one factor of A_f = M/h^2 + L (+ the contact weights
+// it has factored) while the contacts want A = A_f + D, D diagonal (solvers/methods/
+// projective_integrator.h); after delta = -A_f^-1 r, the residual of A delta = -r is D delta,
+// and the best correction in the span of P (the energy's minimizer there) is
+//   delta += P c,   (P' A P) c = -P' D delta.
+// A contact D misses is stiff only against the modes that move many points together (a face
+// pressed into the floor against the whole cube's inertia m/h^2): those are smooth across the
+// lattice, which P spans, while each point's own motion is held by its springs. So the factor
+// need not change when a few points touch or leave.
+#pragma once
+
+#include <Eigen/Dense>
+#include <vector>
+
+#include "solvers/linalg/sparse_matrix.h"
+#include "solvers/step_result.h"
+
+namespace jello {
+
+// The coarse nodes per edge projective and Newton's seeds use (4^3 = 64), and the contacts they
+// leave to the correction: a weight, or its change, under this fraction of its point's diagonal
+// (a heavier one is stiff against the point's own springs, which the coarse space cannot see).
+constexpr int kDefaultCoarseNodes = 4;
+constexpr double kLightContactRatio = 0.5;
+
+class LatticeCoarseSpace {
+ public:
+  // The points of a lattice of `resolution` points per edge, in Lattice::index order, on
+  // `nodes` coarse nodes per edge (2 <= nodes <= resolution).
+  LatticeCoarseSpace(int resolution, int nodes);
+
+  int size() const { return static_cast<int>(base_.rows()); }  // g^3
+
+  // The factored P' (S + diag(w)) P of one set of weights w.
+  struct Factor {
+    Eigen::LLT<Eigen::MatrixXd> llt;
+  };
+
+  // B = P' S P for a symmetric S (n x n, both triangles): the part of P' A P that does not
+  // change with the contacts.
+  void setBase(const SparseMatrix& S);
+  // Factors P' (S + diag(w)) P into out: w, n weights (the wanted contact weights of one
+  // coordinate). Fails when it is not positive definite.
+  StepResult factor(const double* w, Factor& out);
+  // delta += P c with (P' (S + diag(w)) P) c = -P' (d o delta), f holding w's factor: d, n
+  // differences (wanted minus factored weights), delta, n values.
+  void correct(const Factor& f, const double* d, double* delta) const;
+  // x += P c: c, g^3 coarse values; x, n values.
+  void prolong(const double* c, double* x) const;
+
+ private:
+  int n_;
+  std::vector<int> node_;        // n x 8: each point's coarse nodes
+  std::vector<double> weight_;   // n x 8: their hat functions' values at the point
+  Eigen::MatrixXd base_, work_;  // B, and B + P' diag(w) P
+  mutable Eigen::VectorXd g_;
+};
+
+}  // namespace jello
