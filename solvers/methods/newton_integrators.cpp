@@ -118,16 +118,18 @@ std::pair<double, double> NewtonIntegrator::barrierStepBounds(const Model& model
 
 StepResult NewtonIntegrator::seed(const Model& model, double inertia, double h) {
   const auto [a, b] = matrixCoefficients(h);
-  if (StepResult res = system_.factorProjective(a, b); !res.ok) return res;
+  if (StepResult res = system_.factorProjectiveForSeeds(a, b); !res.ok) return res;
   const double scale = -h * h / form_.gamma;
   seedWeights_.start();  // ImplicitOptions::seedChebyshevRho
   for (int k = 0; k < options_.seedIterations; ++k) {
     if (interruptRequested()) return StepResult::interruption();
     evaluate(model, inertia, d_);  // x_e of d_ into xe_
-    if (model.inContact(xe_.data())) break;
+    // Light contacts are corrected on a coarse lattice; at a heavy one Newton takes over.
+    if (!system_.lightContactsAt(xe_.data())) break;
     if (lastResidual_ <= options_.seedTolerance) break;
     delta_ = scale * r_;
     if (StepResult res = system_.solveProjective(delta_); !res.ok) return res;
+    if (StepResult res = system_.correctProjective(delta_); !res.ok) return res;
     ++seeds_;
     if (options_.seedChebyshevRho <= 0.0) {
       d_ += delta_;

@@ -43,6 +43,12 @@ bool ImplicitSystem::bind(const Model& model) {
   laplacian_.reset();
   projective_.reset();
   projectiveA_ = projectiveB_ = -1.0;
+  coarse_.reset();
+  coarseCurrent_ = false;
+  contactDifference_.resize(0);
+  if (model.latticeResolution() >= kDefaultCoarseNodes) {
+    coarse_ = std::make_unique<LatticeCoarseSpace>(model.latticeResolution(), kDefaultCoarseNodes);
+  }
   return true;
 }
 
@@ -104,12 +110,62 @@ StepResult ImplicitSystem::factorProjective(double a, double b, const Eigen::Vec
     projectiveA_ = projectiveB_ = -1.0;
     return result.within("the projective matrix");
   }
+  if (coarse_ && (a != projectiveA_ || b != projectiveB_)) {
+    // The seeds' coarse space: P without C, for new coefficients.
+    if (!noContact) laplacian_->form(model.mass(), a, b, nullptr, freeMatrix_);
+    const SparseMatrix& free = noContact ? projectiveMatrix_ : freeMatrix_;
+    coarse_->setBase(free);
+    freeDiagonal_ = free.diagonal();
+    coarseCurrent_ = false;
+  }
   projectiveA_ = a;
   projectiveB_ = b;
   if (noContact) {
     projectiveContact_.resize(0);
   } else {
     projectiveContact_ = *contact;
+  }
+  return StepResult::success();
+}
+
+StepResult ImplicitSystem::factorProjectiveForSeeds(double a, double b) {
+  if (coarse_ && projective_ && projective_->factored() && a == projectiveA_ && b == projectiveB_) {
+    return StepResult::success();
+  }
+  return factorProjective(a, b);
+}
+
+bool ImplicitSystem::lightContactsAt(const double* x) {
+  JELLO_ASSERT(projective_ && projective_->factored(), "lightContactsAt follows factorProjective");
+  const Model& model = *model_;
+  contactDifference_.resize(0);
+  // The barrier's stiffness has no bound and friction's tangential one is mu N/(eps_v h): the
+  // seeds stop at their contacts, as they do without a lattice.
+  if (!coarse_ || model.barrierContact() || model.hasFriction()) return !model.inContact(x);
+  contactDiagonal(model, x, projectiveA_, projectiveB_, wantedContact_);
+  contactDifference_ = wantedContact_;
+  if (projectiveContact_.size() > 0) contactDifference_ -= projectiveContact_;
+  const bool heavy =
+      (contactDifference_.cwiseAbs().array() > kLightContactRatio * freeDiagonal_.array()).any();
+  if (heavy) contactDifference_.resize(0);
+  return !heavy;
+}
+
+StepResult ImplicitSystem::correctProjective(Eigen::VectorXd& v) {
+  if (contactDifference_.size() == 0 || contactDifference_.isZero(0.0)) {
+    return StepResult::success();
+  }
+  if (!coarseCurrent_ || coarseContact_ != wantedContact_) {
+    coarseCurrent_ = false;
+    if (StepResult res = coarse_->factor(wantedContact_.data(), coarseFactor_); !res.ok) {
+      return res.within("the seeds' coarse correction");
+    }
+    coarseContact_ = wantedContact_;
+    coarseCurrent_ = true;
+  }
+  const Eigen::Index n = contactDifference_.size();
+  for (Eigen::Index c = 0; c < 3; ++c) {
+    coarse_->correct(coarseFactor_, contactDifference_.data(), v.data() + c * n);
   }
   return StepResult::success();
 }

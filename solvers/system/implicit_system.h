@@ -19,6 +19,7 @@
 #include "solvers/integrator.h"
 #include "solvers/linalg/linear_solver.h"
 #include "solvers/system/jacobian.h"
+#include "solvers/system/lattice_coarse_space.h"
 #include "solvers/system/system_operator.h"
 
 namespace jello {
@@ -56,8 +57,21 @@ class ImplicitSystem {
   // it is inside of (kc n n^T <= kc I), given as `contact` (n values, null: none). factorize()
   // sets P up itself for CG, with the contacts of the last assembly's positions.
   StepResult factorProjective(double a, double b, const Eigen::VectorXd* contact = nullptr);
+  // P(a, b) for Newton's seeds: the factor kept when it is for a and b, whatever C it holds
+  // (the preconditioner's contacts: lightContactsAt corrects for the difference); else
+  // factorProjective(a, b) without contacts.
+  StepResult factorProjectiveForSeeds(double a, double b);
   // v <- P^-1 v (3n, component-major) with the last factorProjective.
   StepResult solveProjective(Eigen::VectorXd& v) const;
+  // Newton's seeds through contact: the contact diagonal at positions x (3n), against the C
+  // that P holds. Each difference lighter than half its point's diagonal of P without contacts
+  // is left to a correction of the seed's update on a coarse lattice (correctProjective, as
+  // projective's: solvers/system/lattice_coarse_space.h); false when one is heavier, or the
+  // model is not a lattice of kCoarseNodes^3 points or more (the seeds then stop at contact).
+  bool lightContactsAt(const double* x);
+  // After solveProjective(v): v corrected for the contacts of the last lightContactsAt
+  // (nothing when P holds them all).
+  StepResult correctProjective(Eigen::VectorXd& v);
 
   const SparseMatrix& K() const { return jacobian_->K(); }
   const SparseMatrix& D() const { return jacobian_->D(); }
@@ -86,6 +100,13 @@ class ImplicitSystem {
   double projectiveA_ = -1.0, projectiveB_ = -1.0;  // what projective_ holds
   Eigen::VectorXd projectiveContact_;               // C of projective_ (empty: none)
   Eigen::VectorXd x_, contact_;                     // the last assembly's positions; C there
+  // The seeds' coarse correction: its space (null: not a lattice), P's diagonal without C, the
+  // wanted C and its difference from P's (lightContactsAt), the weights of the coarse factor.
+  std::unique_ptr<LatticeCoarseSpace> coarse_;
+  LatticeCoarseSpace::Factor coarseFactor_;
+  Eigen::VectorXd freeDiagonal_, wantedContact_, contactDifference_, coarseContact_;
+  SparseMatrix freeMatrix_;
+  bool coarseCurrent_ = false;  // coarseFactor_ holds coarseContact_ for P's a and b
   long projectiveFactorizations_ = 0;
   double projectiveSeconds_ = 0.0;
   double assembleSeconds_ = 0.0;
