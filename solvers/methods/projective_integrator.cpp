@@ -140,15 +140,24 @@ StepResult ProjectiveIntegrator::correctOnCoarseNodes() {
     const Eigen::VectorXd& factored = factoredWeights_[factorOf_[c]];
     difference_ = wanted_[c] - factored;
     if (difference_.isZero(0.0)) continue;
-    if (!coarseFactored_[c] || coarseWeights_[c] != wanted_[c]) {
+    // Its own coarse factor, another coordinate's, or a new one (coarseFactorServes).
+    int use = -1;
+    if (coarseFactored_[c] && coarseFactorServes(coarseWeights_[c], wanted_[c])) use = c;
+    for (int e = 0; e < 3 && use < 0; ++e) {
+      if (e != c && coarseFactored_[e] && coarseFactorServes(coarseWeights_[e], wanted_[c])) {
+        use = e;
+      }
+    }
+    if (use < 0) {
       coarseFactored_[c] = false;
       if (StepResult res = coarse_->factor(wanted_[c].data(), coarseFactors_[c]); !res.ok) {
         return res.within("projective coarse correction");
       }
       coarseWeights_[c] = wanted_[c];
       coarseFactored_[c] = true;
+      use = c;
     }
-    coarse_->correct(coarseFactors_[c], difference_.data(), delta_.col(c).data());
+    coarse_->correct(coarseFactors_[use], difference_.data(), delta_.col(c).data());
   }
   ++coarseCorrections_;
   return StepResult::success();

@@ -155,7 +155,7 @@ StepResult ImplicitSystem::correctProjective(Eigen::VectorXd& v) {
   if (contactDifference_.size() == 0 || contactDifference_.isZero(0.0)) {
     return StepResult::success();
   }
-  if (!coarseCurrent_ || coarseContact_ != wantedContact_) {
+  if (!coarseCurrent_ || !coarseFactorServes(coarseContact_, wantedContact_)) {
     coarseCurrent_ = false;
     if (StepResult res = coarse_->factor(wantedContact_.data(), coarseFactor_); !res.ok) {
       return res.within("the seeds' coarse correction");

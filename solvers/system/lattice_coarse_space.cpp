@@ -1,11 +1,22 @@
 #include "solvers/system/lattice_coarse_space.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "src/base/assertions.h"
 #include "src/world/lattice.h"
 
 namespace jello {
+
+bool coarseFactorServes(const Eigen::VectorXd& factored, const Eigen::VectorXd& wanted) {
+  if (factored.size() != wanted.size()) return false;
+  const Eigen::Index n = wanted.size();
+  for (Eigen::Index p = 0; p < n; ++p) {
+    const double a = factored[p], b = wanted[p];
+    if (std::abs(a - b) > 0.25 * std::max(a, b)) return false;  // and 0 against > 0
+  }
+  return true;
+}
 
 LatticeCoarseSpace::LatticeCoarseSpace(int resolution, int nodes) {
   JELLO_ASSERT(resolution >= 2 && nodes >= 2 && nodes <= resolution,

@@ -26,6 +26,12 @@ namespace jello {
 constexpr int kDefaultCoarseNodes = 4;
 constexpr double kLightContactRatio = 0.5;
 
+// Whether a coarse factor of the weights `factored` still serves `wanted`: the same points in
+// contact, each weight within a quarter of the other. The correction's quality depends on it,
+// not the fixed point: smooth contact's weights change a little at each iteration, and a new
+// 64 x 64 factor for each coordinate at each iteration cost a sixth of projective's step.
+bool coarseFactorServes(const Eigen::VectorXd& factored, const Eigen::VectorXd& wanted);
+
 class LatticeCoarseSpace {
  public:
   // The points of a lattice of `resolution` points per edge, in Lattice::index order, on
