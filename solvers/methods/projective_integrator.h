@@ -31,6 +31,7 @@
 // holds stale (solvers/system/lattice_coarse_space.h), which is where a missed contact is stiff
 // (a face pressed against the whole cube's inertia); heavy ones go into the factor as above, and
 // contact_set_changes counts only those. On jello.w at 16^3 one factorization serves the run.
+// A coarse factor serves while its weights stay close (coarseFactorServes).
 // Spring and
 // contact damping, the force field and the user force are evaluated at the iterate (lagged one
 // iteration): at the fixed point they are exactly where backward Euler evaluates them, so the
