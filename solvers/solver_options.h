@@ -13,6 +13,9 @@ struct ImplicitOptions {
   // The converged integrators (implicit, midpoint, newmark, bdf2;
   // solvers/methods/newton_integrators.h).
   int newtonMaxIterations = 30;  // then the step is retried as two half steps
+  // A solve whose residual still falls (halving over ten iterations) may go on to this many
+  // times newtonMaxIterations (solvers/methods/newton_cap.h); 1: the cap is the cap.
+  int newtonCapFactor = 4;
   // A step Newton leaves unconverged is retried as two half steps, each of them so again, down
   // to h / 2^newtonHalvings; a sub-step still unconverged there is accepted, counted, reported.
   int newtonHalvings = 4;

@@ -41,7 +41,8 @@ void warnUnconverged(const Options& opt, const Simulation& sim, double count) {
       halvings > 0 ? ", even in sub-steps of 1/" + std::to_string(1 << halvings) : "";
   std::fprintf(stderr,
                "jello-sim: warning: %.0f of %ld steps taken were accepted unconverged: Newton "
-               "did not converge within %d iterations%s (raise --newton-iters or "
+               "did not converge within %d iterations (more while its residual still fell)%s "
+               "(raise --newton-iters or "
                "--newton-halvings; --strict makes this an error; where a point meets a wall "
                "at speed the penalty's damping force jumps and the step's equations may have "
                "no root: --contact smooth; solvers/README.md, \"implicit\")\n",

@@ -5,6 +5,7 @@
 #include <limits>
 #include <utility>
 
+#include "solvers/methods/newton_cap.h"
 #include "src/base/interrupt.h"
 
 namespace jello {
@@ -212,13 +213,14 @@ StepResult NewtonIntegrator::solve(const Model& model, const State& s, double h,
   converged = false;
   int k = 0;  // this solve's iterations; `iterations` sums the step's, retries included
   double previousNorm = std::numeric_limits<double>::infinity();
+  NewtonCap cap(options_.newtonMaxIterations, options_.newtonCapFactor);
   for (;;) {
     evaluate(model, inertia, d_);
     if (lastResidual_ <= options_.newtonTolerance) {
       converged = true;
       break;
     }
-    if (k >= options_.newtonMaxIterations) break;
+    if (cap.reached(k, lastResidual_)) break;
     if (interruptRequested()) return StepResult::interruption();  // s is still the start
     ++k;
     ++iterations;
@@ -290,6 +292,7 @@ StepResult NewtonIntegrator::solve(const Model& model, const State& s, double h,
     }
     d_ += alpha * delta_;
   }
+  if (cap.extended()) ++extended_;
   return StepResult::success();
 }
 
@@ -324,6 +327,7 @@ std::vector<Statistic> NewtonIntegrator::statistics() const {
       {"newton_retried_steps", static_cast<double>(retries_)},
       {"line_search_cuts", static_cast<double>(cuts_)},
       {"line_search_failures", static_cast<double>(searchFailures_)},
+      {"newton_extended_solves", static_cast<double>(extended_)},
       {"factor_reuses", static_cast<double>(reuses_)},
       {"seed_iterations", static_cast<double>(seeds_)},
       {"seed_chebyshev_restarts", static_cast<double>(seedWeights_.restarts())},

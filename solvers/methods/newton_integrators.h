@@ -136,6 +136,7 @@ class NewtonIntegrator : public Integrator {
   bool lastConverged_ = true;
   long steps_ = 0, iterations_ = 0, maxIterations_ = 0, cuts_ = 0, searchFailures_ = 0,
        unconverged_ = 0, retries_ = 0, reuses_ = 0, seeds_ = 0;
+  long extended_ = 0;  // solves past the cap while converging (solvers/methods/newton_cap.h)
   bool stepUnconverged_ = false;  // a sub-step of the current step was accepted unconverged
   ChebyshevWeights seedWeights_;  // the seed iterations' (ImplicitOptions::seedChebyshevRho)
 };
