@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "solvers/methods/newton_cap.h"
 #include "src/base/interrupt.h"
 
 namespace jello {
@@ -289,12 +290,13 @@ StepResult EnergyMomentum::solve(const Model& model, const State& s, double h, b
   double norm = r_.norm();
   bool factored = false;
   double previous = std::numeric_limits<double>::infinity();
+  NewtonCap cap(options_.newtonMaxIterations, options_.newtonCapFactor);
   for (int k = 0;; ++k) {
     if (norm <= options_.newtonTolerance * scale) {
       converged = true;
       break;
     }
-    if (k >= options_.newtonMaxIterations) break;
+    if (cap.reached(k, norm / scale)) break;
     if (interruptRequested()) return StepResult::interruption();
     // The exact matrix at every iterate; its preconditioner kept while the residual falls fast.
     assemble(model, s, h);
@@ -332,6 +334,7 @@ StepResult EnergyMomentum::solve(const Model& model, const State& s, double h, b
       break;
     }
   }
+  if (cap.extended()) ++extended_;
   if (!x1_.allFinite()) return StepResult::failure("energy-momentum: the step is not finite");
   return StepResult::success();
 }
@@ -422,6 +425,7 @@ std::vector<Statistic> EnergyMomentum::statistics() const {
       {"krylov_iterations", static_cast<double>(krylovIterations_)},
       {"lu_fallbacks", static_cast<double>(luFallbacks_)},
       {"line_search_cuts", static_cast<double>(lineSearchCuts_)},
+      {"newton_extended_solves", static_cast<double>(extended_)},
   };
 }
 

@@ -23,7 +23,8 @@
 // by CHOLMOD; a sparse LU where it stalls) and the midpoint's for contact and damping
 // (2M/h^2 - K/2 - D/h at x_m), and a backtracking line search on |r|. Newton stops at the relative
 // residual ImplicitOptions::newtonTolerance (|r| over |2M/h^2 (x1 - x0 - h v0)| + |F|) or when an
-// update moves no coordinate more than newtonPositionTolerance; at newtonMaxIterations the step is
+// update moves no coordinate more than newtonPositionTolerance; at newtonMaxIterations (further
+// while |r| still halves every ten iterations: solvers/methods/newton_cap.h) the step is
 // retried as two half steps, down to h / 2^newtonHalvings, where it is accepted, counted and
 // reported unconverged (never silently).
 #pragma once
@@ -103,6 +104,7 @@ class EnergyMomentum final : public Integrator {
   bool springDamping_ = false;  // any spring with damping
   bool isolated_ = false;       // the last evaluation had springs alone (no damping)
   long steps_ = 0, iterations_ = 0, unconverged_ = 0, retries_ = 0, factorizations_ = 0;
+  long extended_ = 0;  // solves past the cap while converging (solvers/methods/newton_cap.h)
   long lineSearchCuts_ = 0;
   long maxIterations_ = 0;
 };
