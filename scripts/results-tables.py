@@ -520,7 +520,7 @@ def crossover_ms():
 
 
 def findings():
-    """The README's findings, five sentences, every figure from the committed results."""
+    """The README's findings, five paragraphs, every figure from the committed results."""
     rows = [r for r in read_rows("stability") if r["scene"] == "free"]
     by = {}
     for r in rows:
@@ -585,7 +585,47 @@ def findings():
               f"{cross[('rk4', '5')]:.3g} ms at its stability limit "
               f"({cross[('rk4', '5')] / cross[(pd, '5')]:.2g}x, one core, the native build); no "
               "comparison with other libraries is committed here.")
-    return "\n\n".join([first, second, third, fourth])
+    return "\n\n".join([first, second, third, fourth, contact_finding()])
+
+
+def contact_finding():
+    """What contact costs: projective's step at 16^3 per contact model (contact_speed.json), and
+    backward Euler's unconverged steps per model over the contact table's scenes."""
+    speed_path = os.path.join(RESULTS, "contact_speed.json")
+    table_path = os.path.join(RESULTS, "contact_models.json")
+    if not (os.path.exists(speed_path) and os.path.exists(table_path)):
+        return "**Through contact**: not measured yet (`scripts/contact-speed.py`, `contact-table.py`)."
+    with open(speed_path) as f:
+        speed = json.load(f)
+    pd = closed_sets.names("Projective")[0]
+    # Backward Euler: the Newton family's member whose linear model is backward Euler's.
+    be = next(r["name"] for r in closed_sets.integrators()
+              if r["family"] == "Newton" and r["linear_model"] == "BackwardEuler")
+    steps = {}
+    for b in speed["benchmarks"]:
+        parts = b["name"].split("/")
+        if b.get("run_type", "iteration") == "iteration" and parts[1] == pd and \
+                parts[3] == "N:16":
+            steps[parts[2]] = (b["real_time"], b.get("factorizations", 0))
+    with open(table_path) as f:
+        runs = [r for r in json.load(f)["runs"] if r["integrator"] == be]
+    models = list(dict.fromkeys(r["contact"] for r in runs))
+    left = {m: sum(r["unconverged_steps"] for r in runs if r["contact"] == m) for m in models}
+    total = {m: sum(r["steps"] for r in runs if r["contact"] == m) for m in models}
+    scenes = sorted({r["scene"] for r in runs})
+    most = max(f for _, f in steps.values())
+    if not any(left.values()):
+        newton = (f"with its retries in half steps, backward Euler leaves none of its "
+                  f"{max(total.values())} steps unconverged under any model")
+    else:
+        newton = "backward Euler leaves " + ", ".join(
+            f"{left[m]} of {total[m]} steps unconverged under {m}" for m in models)
+    return ("**Through contact**: projective keeps "
+            + ("one factorization" if most == 1 else f"at most {most:.0f} factorizations")
+            + " on jello.w at 16^3, a step taking "
+            + ", ".join(f"{ms:.3g} ms under {m}" for m, (ms, _) in steps.items())
+            + " contact (30 steps at dt = 0.01 s, one core); " + newton
+            + f" over the contact table's scenes ({'; '.join(scenes)}).")
 
 
 def implicit_damping_loss():
