@@ -114,7 +114,7 @@ struct ProjectiveOptions {
   int chebyshevDelay = 2;
   // Coarse correction of contacts the factor misses (solvers/system/lattice_coarse_space.h):
   // on a lattice's points, g^3 coarse nodes (g = coarseNodes; 0: off, the factor then follows
-  // every contact). A contact whose weight is under kCoarseWeightRatio of its point's diagonal
+  // every contact). A contact whose weight is under kLightContactRatio of its point's diagonal
   // leaves the factor as it is, and each global solve is corrected on the coarse nodes.
   int coarseNodes = 4;
 };

@@ -72,7 +72,6 @@ void ProjectiveIntegrator::bind(const Model& model) {
     weights_[c].setZero(n_);
     wanted_[c].setZero(n_);
     factoredWeights_[c].setZero(n_);
-    coarseWeights_[c].setZero(n_);
   }
   coarse_.reset();
   const int resolution = model.latticeResolution();
@@ -116,7 +115,7 @@ long ProjectiveIntegrator::contactWeights(const Model& model, const double* x, s
     const double* wc = w[c];
     const double* factored = factoredWeights_[factorOf_[c]].data();
     if (coarse_) {
-      const double* diagonal = freeDiagonal_.data();
+      const double* diagonal = coarse_->baseDiagonal().data();
 #pragma omp simd reduction(+ : count, others)
       for (std::ptrdiff_t p = lo; p < hi; ++p) {
         const double change = std::abs(wc[p] - factored[p]);
@@ -137,27 +136,10 @@ long ProjectiveIntegrator::contactWeights(const Model& model, const double* x, s
 
 StepResult ProjectiveIntegrator::correctOnCoarseNodes() {
   for (int c = 0; c < 3; ++c) {
-    const Eigen::VectorXd& factored = factoredWeights_[factorOf_[c]];
-    difference_ = wanted_[c] - factored;
+    difference_ = wanted_[c] - factoredWeights_[factorOf_[c]];
     if (difference_.isZero(0.0)) continue;
-    // Its own coarse factor, another coordinate's, or a new one (coarseFactorServes).
-    int use = -1;
-    if (coarseFactored_[c] && coarseFactorServes(coarseWeights_[c], wanted_[c])) use = c;
-    for (int e = 0; e < 3 && use < 0; ++e) {
-      if (e != c && coarseFactored_[e] && coarseFactorServes(coarseWeights_[e], wanted_[c])) {
-        use = e;
-      }
-    }
-    if (use < 0) {
-      coarseFactored_[c] = false;
-      if (StepResult res = coarse_->factor(wanted_[c].data(), coarseFactors_[c]); !res.ok) {
-        return res.within("projective coarse correction");
-      }
-      coarseWeights_[c] = wanted_[c];
-      coarseFactored_[c] = true;
-      use = c;
-    }
-    coarse_->correct(coarseFactors_[use], difference_.data(), delta_.col(c).data());
+    StepResult res = coarse_->correct(wanted_[c], difference_.data(), delta_.col(c).data());
+    if (!res.ok) return res.within("projective coarse correction");
   }
   ++coarseCorrections_;
   return StepResult::success();
@@ -201,11 +183,9 @@ StepResult ProjectiveIntegrator::factorChanged(double h) {
   const bool all = !factored_ || h != h_;
   const double inertia = mass_ / (h * h);
   if (all && coarse_) {
-    // The coarse space's base and the diagonal a contact's weight is weighed against.
+    // The coarse space's base, whose diagonal a contact's weight is weighed against.
     laplacian_->form(inertia, dampingRate_, 1.0, nullptr, free_);
     coarse_->setBase(free_);
-    freeDiagonal_ = free_.diagonal();
-    coarseFactored_.fill(false);
   }
   for (int c = 0; c < 3; ++c) {
     // A coordinate whose matrix equals an earlier one's shares its factor.
@@ -309,6 +289,10 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
   if (plan && planWeights(model, x0, v0, h)) {
     if (StepResult res = factorChanged(h); !res.ok) return res;
   }
+  if (coarse_ && (!factored_ || h != h_)) {
+    // The factor for h before the first weights: they are weighed against its diagonal.
+    if (StepResult res = factorChanged(h); !res.ok) return res;
+  }
   int iterations = 0;
   chebyshev_.start();  // ProjectiveOptions::chebyshevRho
   for (; iterations < options_.iterations; ++iterations) {
@@ -318,10 +302,6 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
     // right-hand side -r = f - M (x - y)/h^2 and the contact weights at x, in the same pass.
     std::atomic<long> uncovered{0};  // weights above those of the factor its coordinate uses
     std::atomic<long> light{0};      // the coarse correction's
-    if (coarse_ && (!factored_ || h != h_)) {
-      // The factor for h before the first weights: they are weighed against its diagonal.
-      if (StepResult res = factorChanged(h); !res.ok) return res;
-    }
     model.forces(x, v, f_.data(), [&](std::ptrdiff_t lo, std::ptrdiff_t hi) {
       for (std::ptrdiff_t c = 0; c < 3; ++c) {
         for (std::ptrdiff_t i = c * n + lo; i < c * n + hi; ++i) {

@@ -31,7 +31,7 @@
 // holds stale (solvers/system/lattice_coarse_space.h), which is where a missed contact is stiff
 // (a face pressed against the whole cube's inertia); heavy ones go into the factor as above, and
 // contact_set_changes counts only those. On jello.w at 16^3 one factorization serves the run.
-// A coarse factor serves while its weights stay close (coarseFactorServes).
+// A coarse factor serves while its weights stay close (LatticeCoarseSpace::correct).
 // Spring and
 // contact damping, the force field and the user force are evaluated at the iterate (lagged one
 // iteration): at the fixed point they are exactly where backward Euler evaluates them, so the
@@ -121,14 +121,10 @@ class ProjectiveIntegrator final : public Integrator {
   int lastIterations_ = 0;
   double lastUpdate_ = 0.0;
   std::vector<std::pair<int, double>> changes_;  // a coordinate's changed contact weights
-  // The coarse correction (coarseNodes): its space, A's diagonal without contact weights (which
-  // weight a contact may leave to it), and per coordinate the weights its coarse factor has.
+  // The coarse correction (coarseNodes): its space, and one coordinate's weight differences.
   std::unique_ptr<LatticeCoarseSpace> coarse_;
   SparseMatrix free_;  // M/h^2 + L (+ L_c/h), the coarse space's base
-  Eigen::VectorXd freeDiagonal_, difference_;
-  std::array<LatticeCoarseSpace::Factor, 3> coarseFactors_;
-  std::array<Eigen::VectorXd, 3> coarseWeights_;
-  std::array<bool, 3> coarseFactored_{};
+  Eigen::VectorXd difference_;
   long coarseCorrections_ = 0;
   long steps_ = 0, iterations_ = 0, factorizations_ = 0, contactChanges_ = 0, updates_ = 0;
   long barrierCuts_ = 0;  // updates cut short by the barrier

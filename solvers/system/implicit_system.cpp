@@ -44,8 +44,7 @@ bool ImplicitSystem::bind(const Model& model) {
   projective_.reset();
   projectiveA_ = projectiveB_ = -1.0;
   coarse_.reset();
-  coarseCurrent_ = false;
-  contactDifference_.resize(0);
+  correctContacts_ = false;
   if (model.latticeResolution() >= kDefaultCoarseNodes) {
     coarse_ = std::make_unique<LatticeCoarseSpace>(model.latticeResolution(), kDefaultCoarseNodes);
   }
@@ -115,8 +114,6 @@ StepResult ImplicitSystem::factorProjective(double a, double b, const Eigen::Vec
     if (!noContact) laplacian_->form(model.mass(), a, b, nullptr, freeMatrix_);
     const SparseMatrix& free = noContact ? projectiveMatrix_ : freeMatrix_;
     coarse_->setBase(free);
-    freeDiagonal_ = free.diagonal();
-    coarseCurrent_ = false;
   }
   projectiveA_ = a;
   projectiveB_ = b;
@@ -138,34 +135,24 @@ StepResult ImplicitSystem::factorProjectiveForSeeds(double a, double b) {
 bool ImplicitSystem::lightContactsAt(const double* x) {
   JELLO_ASSERT(projective_ && projective_->factored(), "lightContactsAt follows factorProjective");
   const Model& model = *model_;
-  contactDifference_.resize(0);
+  correctContacts_ = false;
   // The barrier's stiffness has no bound and friction's tangential one is mu N/(eps_v h): the
   // seeds stop at their contacts, as they do without a lattice.
   if (!coarse_ || model.barrierContact() || model.hasFriction()) return !model.inContact(x);
   contactDiagonal(model, x, projectiveA_, projectiveB_, wantedContact_);
   contactDifference_ = wantedContact_;
   if (projectiveContact_.size() > 0) contactDifference_ -= projectiveContact_;
-  const bool heavy =
-      (contactDifference_.cwiseAbs().array() > kLightContactRatio * freeDiagonal_.array()).any();
-  if (heavy) contactDifference_.resize(0);
-  return !heavy;
+  if (!coarse_->light(contactDifference_)) return false;
+  correctContacts_ = !contactDifference_.isZero(0.0);
+  return true;
 }
 
 StepResult ImplicitSystem::correctProjective(Eigen::VectorXd& v) {
-  if (contactDifference_.size() == 0 || contactDifference_.isZero(0.0)) {
-    return StepResult::success();
-  }
-  if (!coarseCurrent_ || !coarseFactorServes(coarseContact_, wantedContact_)) {
-    coarseCurrent_ = false;
-    if (StepResult res = coarse_->factor(wantedContact_.data(), coarseFactor_); !res.ok) {
-      return res.within("the seeds' coarse correction");
-    }
-    coarseContact_ = wantedContact_;
-    coarseCurrent_ = true;
-  }
+  if (!correctContacts_) return StepResult::success();
   const Eigen::Index n = contactDifference_.size();
   for (Eigen::Index c = 0; c < 3; ++c) {
-    coarse_->correct(coarseFactor_, contactDifference_.data(), v.data() + c * n);
+    StepResult res = coarse_->correct(wantedContact_, contactDifference_.data(), v.data() + c * n);
+    if (!res.ok) return res.within("the seeds' coarse correction");
   }
   return StepResult::success();
 }

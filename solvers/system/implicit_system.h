@@ -100,13 +100,12 @@ class ImplicitSystem {
   double projectiveA_ = -1.0, projectiveB_ = -1.0;  // what projective_ holds
   Eigen::VectorXd projectiveContact_;               // C of projective_ (empty: none)
   Eigen::VectorXd x_, contact_;                     // the last assembly's positions; C there
-  // The seeds' coarse correction: its space (null: not a lattice), P's diagonal without C, the
-  // wanted C and its difference from P's (lightContactsAt), the weights of the coarse factor.
+  // The seeds' coarse correction: its space (null: not a lattice; its base is P without C), the
+  // wanted C and its difference from P's (lightContactsAt), and whether there is one to correct.
   std::unique_ptr<LatticeCoarseSpace> coarse_;
-  LatticeCoarseSpace::Factor coarseFactor_;
-  Eigen::VectorXd freeDiagonal_, wantedContact_, contactDifference_, coarseContact_;
+  Eigen::VectorXd wantedContact_, contactDifference_;
   SparseMatrix freeMatrix_;
-  bool coarseCurrent_ = false;  // coarseFactor_ holds coarseContact_ for P's a and b
+  bool correctContacts_ = false;
   long projectiveFactorizations_ = 0;
   double projectiveSeconds_ = 0.0;
   double assembleSeconds_ = 0.0;

@@ -8,7 +8,10 @@
 
 namespace jello {
 
-bool coarseFactorServes(const Eigen::VectorXd& factored, const Eigen::VectorXd& wanted) {
+namespace {
+
+// Whether a coarse factor of the weights `factored` still serves `wanted` (correct's rule).
+bool serves(const Eigen::VectorXd& factored, const Eigen::VectorXd& wanted) {
   if (factored.size() != wanted.size()) return false;
   const Eigen::Index n = wanted.size();
   for (Eigen::Index p = 0; p < n; ++p) {
@@ -17,6 +20,8 @@ bool coarseFactorServes(const Eigen::VectorXd& factored, const Eigen::VectorXd& 
   }
   return true;
 }
+
+}  // namespace
 
 LatticeCoarseSpace::LatticeCoarseSpace(int resolution, int nodes) {
   JELLO_ASSERT(resolution >= 2 && nodes >= 2 && nodes <= resolution,
@@ -55,6 +60,8 @@ LatticeCoarseSpace::LatticeCoarseSpace(int resolution, int nodes) {
 
 void LatticeCoarseSpace::setBase(const SparseMatrix& S) {
   JELLO_ASSERT(S.rows() == n_ && S.cols() == n_, "the coarse space's matrix has its points");
+  diagonal_ = S.diagonal();
+  kept_ = next_ = 0;
   base_.setZero();
   for (int j = 0; j < n_; ++j) {
     const int* nj = &node_[8 * std::size_t(j)];
@@ -70,7 +77,21 @@ void LatticeCoarseSpace::setBase(const SparseMatrix& S) {
   }
 }
 
-StepResult LatticeCoarseSpace::factor(const double* w, Factor& out) {
+bool LatticeCoarseSpace::light(const Eigen::VectorXd& d) const {
+  return (d.cwiseAbs().array() <= kLightContactRatio * diagonal_.array()).all();
+}
+
+StepResult LatticeCoarseSpace::factorFor(const Eigen::VectorXd& w, const Factor** out) {
+  for (int i = 0; i < kept_; ++i) {
+    if (serves(factors_[i].w, w)) {
+      *out = &factors_[i];
+      return StepResult::success();
+    }
+  }
+  Factor& f = factors_[next_];
+  next_ = (next_ + 1) % static_cast<int>(factors_.size());
+  kept_ = std::min(kept_ + 1, static_cast<int>(factors_.size()));
+  f.w.resize(0);  // no factor here until this one succeeds
   work_ = base_;
   for (int p = 0; p < n_; ++p) {
     if (w[p] == 0.0) continue;
@@ -81,14 +102,18 @@ StepResult LatticeCoarseSpace::factor(const double* w, Factor& out) {
       for (int a = 0; a < 8; ++a) work_(np[a], np[b]) += s * wp[a];
     }
   }
-  out.llt.compute(work_);
-  if (out.llt.info() != Eigen::Success) {
+  f.llt.compute(work_);
+  if (f.llt.info() != Eigen::Success) {
     return StepResult::failure("the coarse correction's matrix is not positive definite");
   }
+  f.w = w;
+  *out = &f;
   return StepResult::success();
 }
 
-void LatticeCoarseSpace::correct(const Factor& f, const double* d, double* delta) const {
+StepResult LatticeCoarseSpace::correct(const Eigen::VectorXd& w, const double* d, double* delta) {
+  const Factor* f = nullptr;
+  if (StepResult res = factorFor(w, &f); !res.ok) return res;
   g_.setZero();
   for (int p = 0; p < n_; ++p) {
     if (d[p] == 0.0) continue;
@@ -97,8 +122,9 @@ void LatticeCoarseSpace::correct(const Factor& f, const double* d, double* delta
     const double* wp = &weight_[8 * std::size_t(p)];
     for (int a = 0; a < 8; ++a) g_[np[a]] -= r * wp[a];
   }
-  f.llt.solveInPlace(g_);
+  f->llt.solveInPlace(g_);
   prolong(g_.data(), delta);
+  return StepResult::success();
 }
 
 void LatticeCoarseSpace::prolong(const double* c, double* x) const {

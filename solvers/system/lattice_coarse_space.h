@@ -13,6 +13,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <array>
 #include <vector>
 
 #include "solvers/linalg/sparse_matrix.h"
@@ -26,12 +27,6 @@ namespace jello {
 constexpr int kDefaultCoarseNodes = 4;
 constexpr double kLightContactRatio = 0.5;
 
-// Whether a coarse factor of the weights `factored` still serves `wanted`: the same points in
-// contact, each weight within a quarter of the other. The correction's quality depends on it,
-// not the fixed point: smooth contact's weights change a little at each iteration, and a new
-// 64 x 64 factor for each coordinate at each iteration cost a sixth of projective's step.
-bool coarseFactorServes(const Eigen::VectorXd& factored, const Eigen::VectorXd& wanted);
-
 class LatticeCoarseSpace {
  public:
   // The points of a lattice of `resolution` points per edge, in Lattice::index order, on
@@ -40,29 +35,42 @@ class LatticeCoarseSpace {
 
   int size() const { return static_cast<int>(base_.rows()); }  // g^3
 
-  // The factored P' (S + diag(w)) P of one set of weights w.
-  struct Factor {
-    Eigen::LLT<Eigen::MatrixXd> llt;
-  };
-
   // B = P' S P for a symmetric S (n x n, both triangles): the part of P' A P that does not
-  // change with the contacts.
+  // change with the contacts. Keeps S's diagonal (what a contact's weight is weighed against)
+  // and forgets the factors of the last S.
   void setBase(const SparseMatrix& S);
-  // Factors P' (S + diag(w)) P into out: w, n weights (the wanted contact weights of one
-  // coordinate). Fails when it is not positive definite.
-  StepResult factor(const double* w, Factor& out);
-  // delta += P c with (P' (S + diag(w)) P) c = -P' (d o delta), f holding w's factor: d, n
-  // differences (wanted minus factored weights), delta, n values.
-  void correct(const Factor& f, const double* d, double* delta) const;
+  const Eigen::VectorXd& baseDiagonal() const { return diagonal_; }
+  // Whether a weight change d (n values) is light at every point: under kLightContactRatio of
+  // the base's diagonal there.
+  bool light(const Eigen::VectorXd& d) const;
+  // delta += P c with (P' (S + diag(w)) P) c = -P' (d o delta): w, n weights (the wanted
+  // contact weights of one coordinate); d, n differences (wanted minus factored weights); delta,
+  // n values. The coarse factors of the last few w are kept and serve while the same points
+  // are in contact and each weight is within a quarter of the one factored: the correction's
+  // quality depends on it, not the fixed point (smooth contact's weights change a little at each
+  // iteration, and a new 64 x 64 factor for each coordinate at each iteration cost a sixth of
+  // projective's step). Fails when the coarse matrix is not positive definite.
+  StepResult correct(const Eigen::VectorXd& w, const double* d, double* delta);
   // x += P c: c, g^3 coarse values; x, n values.
   void prolong(const double* c, double* x) const;
 
  private:
+  // The factored P' (S + diag(w)) P of one set of weights w.
+  struct Factor {
+    Eigen::VectorXd w;
+    Eigen::LLT<Eigen::MatrixXd> llt;
+  };
+  // A kept factor that serves w, or a new one in the oldest slot.
+  StepResult factorFor(const Eigen::VectorXd& w, const Factor** out);
+
   int n_;
-  std::vector<int> node_;        // n x 8: each point's coarse nodes
-  std::vector<double> weight_;   // n x 8: their hat functions' values at the point
-  Eigen::MatrixXd base_, work_;  // B, and B + P' diag(w) P
-  mutable Eigen::VectorXd g_;
+  std::vector<int> node_;          // n x 8: each point's coarse nodes
+  std::vector<double> weight_;     // n x 8: their hat functions' values at the point
+  Eigen::MatrixXd base_, work_;    // B, and B + P' diag(w) P
+  Eigen::VectorXd diagonal_;       // S's
+  std::array<Factor, 3> factors_;  // one per coordinate at most
+  int kept_ = 0, next_ = 0;        // factors_ in use; the slot the next new one takes
+  Eigen::VectorXd g_;
 };
 
 }  // namespace jello
