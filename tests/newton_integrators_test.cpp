@@ -403,11 +403,12 @@ TEST(NewtonIntegrators, SeedsGoOnThroughLightContacts) {
     std::map<std::string, double> stats, plainStats;
     for (const Statistic& s : b->statistics()) stats[s.name] = s.value;
     for (const Statistic& s : a->statistics()) plainStats[s.name] = s.value;
+    // Shown for solvers/README.md's figures; asserted below (at most half of plain Newton's).
     std::printf("%s in contact: Newton iterations %g plain, %g after %g seed iterations\n",
                 std::string(integratorName(kind)).c_str(), plainStats.at("newton_iterations"),
                 stats.at("newton_iterations"), stats.at("seed_iterations"));
     EXPECT_GE(stats.at("seed_iterations"), 30.0);
-    EXPECT_LT(stats.at("newton_iterations"), plainStats.at("newton_iterations"));
+    EXPECT_LT(2.0 * stats.at("newton_iterations"), plainStats.at("newton_iterations"));
   }
 }
 

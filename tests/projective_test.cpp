@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <vector>
 
@@ -55,6 +56,34 @@ State projectiveStep(const Model& model, const State& start, double h, int itera
 // |x_projective - x_BE| / |x_BE - x0|: the step's error relative to the step.
 double relativeStepError(const State& start, const State& be, const State& pd) {
   return (pd.x - be.x).norm() / (be.x - start.x).norm();
+}
+
+// w's cube thrown straight down at `speed` m/s, toward the floor z = -2.
+State thrownDown(const World& w, double speed) {
+  State s = initialState(w);
+  const int n = s.numPoints();
+  for (int p = 0; p < n; ++p) s.v[2 * n + p] = -speed;
+  return s;
+}
+
+// `steps` steps of pd from s at h = 0.01: the deepest any point went below the floor (m).
+double stepOverTheFloor(Integrator& pd, const Model& model, State& s, int steps) {
+  const int n = s.numPoints();
+  double deepest = 0.0;
+  for (int i = 0; i < steps; ++i) {
+    if (!pd.step(model, s, 0.01).ok) {
+      ADD_FAILURE() << "step " << i << " failed";
+      return std::numeric_limits<double>::infinity();
+    }
+    deepest = std::max(deepest, -2.0 - s.x.segment(2 * n, n).minCoeff());
+  }
+  return deepest;
+}
+
+std::map<std::string, double> statisticsOf(const Integrator& pd) {
+  std::map<std::string, double> stats;
+  for (const Statistic& st : pd.statistics()) stats[st.name] = st.value;
+  return stats;
 }
 
 World spinningCube(double k, double damping) {
@@ -221,14 +250,8 @@ TEST(Projective, FactorsOncePerSceneAndStepSizeAndAgainOnContactChanges) {
   ProjectiveOptions exact;
   exact.coarseNodes = 0;
   ProjectiveIntegrator thrown(exact);
-  State t = initialState(w);
-  const int n = t.numPoints();
-  for (int p = 0; p < n; ++p) t.v[2 * n + p] = -20.0;
-  double deepest = 0.0;
-  for (int i = 0; i < 30; ++i) {
-    ASSERT_TRUE(thrown.step(wall, t, 0.01).ok);
-    deepest = std::max(deepest, -2.0 - t.x.segment(2 * n, n).minCoeff());
-  }
+  State t = thrownDown(w, 20.0);
+  const double deepest = stepOverTheFloor(thrown, wall, t, 30);
   EXPECT_GT(thrown.refactorizations(), 1);
   EXPECT_LT(deepest, 0.05);  // the penalty holds it within 5 cm
   double changes = -1.0, updates = -1.0;
@@ -243,9 +266,8 @@ TEST(Projective, FactorsOncePerSceneAndStepSizeAndAgainOnContactChanges) {
   ProjectiveOptions refactorOnly = exact;
   refactorOnly.updateFactors = false;
   ProjectiveIntegrator fresh(refactorOnly);
-  State u = initialState(w);
-  for (int p = 0; p < n; ++p) u.v[2 * n + p] = -20.0;
-  for (int i = 0; i < 30; ++i) ASSERT_TRUE(fresh.step(wall, u, 0.01).ok);
+  State u = thrownDown(w, 20.0);
+  (void)stepOverTheFloor(fresh, wall, u, 30);
   EXPECT_LT((u.x - t.x).cwiseAbs().maxCoeff(), 1e-10);
   EXPECT_GT(fresh.refactorizations(), thrown.refactorizations());
 }
@@ -305,14 +327,9 @@ TEST(Projective, LightContactsLeaveTheFactorToTheCoarseCorrection) {
   const auto thrown = [&](ProjectiveOptions o, std::map<std::string, double>* stats,
                           double* deepest) {
     ProjectiveIntegrator pd(o);
-    State s = initialState(w);
-    const int n = s.numPoints();
-    for (int p = 0; p < n; ++p) s.v[2 * n + p] = -20.0;
-    for (int i = 0; i < 30; ++i) {
-      EXPECT_TRUE(pd.step(model, s, 0.01).ok);
-      *deepest = std::max(*deepest, -2.0 - s.x.segment(2 * n, n).minCoeff());
-    }
-    for (const Statistic& st : pd.statistics()) (*stats)[st.name] = st.value;
+    State s = thrownDown(w, 20.0);
+    *deepest = stepOverTheFloor(pd, model, s, 30);
+    *stats = statisticsOf(pd);
     return s;
   };
   std::map<std::string, double> stats, exactStats;
@@ -326,6 +343,7 @@ TEST(Projective, LightContactsLeaveTheFactorToTheCoarseCorrection) {
   const State b = thrown(convergedExact, &exactStats, &deepestExact);
   const double moved = (a.x - initialState(w).x).cwiseAbs().maxCoeff();
   const double apart = (a.x - b.x).cwiseAbs().maxCoeff();
+  // Shown for solvers/README.md; asserted below.
   std::printf(
       "thrown at the floor, converged: %.3g m apart after moving %.3g m; %g corrected "
       "solves\n",
@@ -347,9 +365,7 @@ TEST(Projective, LightContactsLeaveTheFactorToTheCoarseCorrection) {
   ProjectiveOptions following;
   following.coarseNodes = 0;
   ProjectiveIntegrator driver;
-  State s = initialState(w);
-  const int n = s.numPoints();
-  for (int p = 0; p < n; ++p) s.v[2 * n + p] = -20.0;
+  State s = thrownDown(w, 20.0);
   double worst[2] = {0.0, 0.0}, sum[2] = {0.0, 0.0};
   for (int i = 0; i < 30; ++i) {
     const State fixedPoint = projectiveStep(model, s, 0.01, 3000, 0.0, convergedExact);
@@ -361,6 +377,7 @@ TEST(Projective, LightContactsLeaveTheFactorToTheCoarseCorrection) {
     }
     ASSERT_TRUE(driver.step(model, s, 0.01).ok);
   }
+  // Shown for solvers/README.md; asserted below (within 10% of the following factor's).
   std::printf(
       "10 iterations from each state of the throw: worst %.4g, mean %.4g of the step "
       "(following every contact: %.4g, %.4g)\n",
@@ -376,16 +393,9 @@ TEST(Projective, HeavyContactsStillEnterTheFactor) {
   w.kCollision = 1e5;
   const Model model(w);
   ProjectiveIntegrator pd;
-  State s = initialState(w);
-  const int n = s.numPoints();
-  for (int p = 0; p < n; ++p) s.v[2 * n + p] = -5.0;
-  double deepest = 0.0;
-  for (int i = 0; i < 30; ++i) {
-    ASSERT_TRUE(pd.step(model, s, 0.01).ok);
-    deepest = std::max(deepest, -2.0 - s.x.segment(2 * n, n).minCoeff());
-  }
-  std::map<std::string, double> stats;
-  for (const Statistic& st : pd.statistics()) stats[st.name] = st.value;
+  State s = thrownDown(w, 5.0);
+  const double deepest = stepOverTheFloor(pd, model, s, 30);
+  const std::map<std::string, double> stats = statisticsOf(pd);
   EXPECT_GE(stats.at("contact_set_changes"), 1.0);
   EXPECT_GE(stats.at("factor_updates") + stats.at("factorizations"), 2.0);
   EXPECT_LT(deepest, 0.01);
@@ -400,16 +410,9 @@ TEST(Projective, LargeFactorsTakeContactChangesAsACorrectionWithTheSameSteps) {
   const Model model(w);
   const auto thrownAtTheFloor = [&](const ProjectiveOptions& options, double* deepest) {
     ProjectiveIntegrator pd(options);
-    State s = initialState(w);
-    const int n = s.numPoints();
-    for (int p = 0; p < n; ++p) s.v[2 * n + p] = -20.0;
-    for (int i = 0; i < 20; ++i) {
-      EXPECT_TRUE(pd.step(model, s, 0.01).ok);
-      *deepest = std::max(*deepest, -2.0 - s.x.segment(2 * n, n).minCoeff());
-    }
-    std::map<std::string, double> stats;
-    for (const Statistic& st : pd.statistics()) stats[st.name] = st.value;
-    return std::make_pair(s, stats);
+    State s = thrownDown(w, 20.0);
+    *deepest = stepOverTheFloor(pd, model, s, 20);
+    return std::make_pair(s, statisticsOf(pd));
   };
   // Iterated close to the fixed point, which the factor does not change (residuals in double):
   // ten iterations would magnify the two factors' rounding into the iterates.
