@@ -22,8 +22,8 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 struct JacobianOptions {
   bool clampCompression = true;
   bool includeField = false;  // the field's gradient is not symmetric: not for Cholesky
-  // The velocities (3n) friction's D is evaluated at: the one term of D that depends on v
-  // (null: friction is left out of D).
+  // The velocities (3n) friction's D is evaluated at, the one term of D that depends on v, and
+  // the smooth contact's damping term of K, c vn w'(q) (null: both are left out).
   const double* velocities = nullptr;
 };
 
@@ -32,7 +32,7 @@ class JacobianAssembler {
   explicit JacobianAssembler(const Model& model);
 
   // Refills K and D at positions x, 3n component-major (every force but friction is linear in
-  // v: friction's D is evaluated at options.velocities).
+  // v: friction's D, and K's smooth-contact damping term, at options.velocities).
   void assemble(const double* x, const JacobianOptions& options);
 
   const SparseMatrix& K() const { return K_; }

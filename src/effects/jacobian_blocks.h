@@ -22,7 +22,8 @@ struct JacobianBlocks {
   bool clampCompression = true;
   // The field's gradient (not symmetric: not for Cholesky).
   bool includeField = false;
-  // The velocities (3n) friction's D is evaluated at; none: friction is left out of D.
+  // The velocities (3n) friction's D and the smooth law's damping term of K are evaluated at;
+  // none: both are left out.
   const double* velocities = nullptr;
   // Friction's D blocks go here (9 per point) instead of diagD when set (the assembler keeps
   // them apart for Newton's merit, then adds them to D).

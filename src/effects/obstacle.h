@@ -115,8 +115,9 @@ class Obstacle {
     return k_.model == ContactModel::Penalty ? penaltyEnergy(x, n) : lawEnergy(x, n);
   }
   // K = df/dx and D = df/dv on each touching point's diagonal block (src/effects/
-  // jacobian_blocks.h): K = -(e'' g g^T + e' Hess(q)), D = -dc w n n^T; the curvature term
-  // e' Hess(q) is dropped under the clamp; friction's D where out gives the velocities.
+  // jacobian_blocks.h): K = -(e'' g g^T + e' Hess(q)) + dc vn w'(q) |g| n n^T, D = -dc w n n^T;
+  // under the clamp the curvature term e' Hess(q) and the weight's term moving out (vn > 0)
+  // are dropped; the weight's term and friction's D only where out gives the velocities.
   void addJacobian(const double* x, int n, JacobianBlocks& out) const {
     if (k_.model == ContactModel::Penalty) {
       addPenaltyJacobian(x, n, out);
@@ -211,6 +212,8 @@ class Obstacle {
   // The elastic normal force's magnitude (N) of a contact at depth q under the scene's law.
   double normalForce(double depth) const;
   double dampingWeight(const ContactLawValue& e) const;
+  // dw/dq at depth q: 1/layer inside the smooth law's layer, else 0.
+  double dampingWeightSlope(double depth) const;
   bool addLawForces(const double* x, const double* v, double* f, int n, int lo, int hi) const;
   double lawEnergy(const double* x, int n) const;
   void addLawJacobian(const double* x, int n, JacobianBlocks& out) const;
