@@ -54,8 +54,19 @@ Eigen::VectorXd methodResidual(IntegratorKind kind, const Model& model, const St
       return 4.0 * m / (h * h) * (after.x - before.x - h * before.v) - m * a0 - f1;
     }
     case IntegratorKind::Bdf2: {
-      if (!bdf2Started) {  // started by backward Euler
-        return methodResidual(IntegratorKind::Implicit, model, before2, before, after, h, false);
+      if (!bdf2Started) {
+        // Started from a history made up behind the start by a backward-Euler pilot step,
+        // taken here by an integrator of its own: x_-1 = x0 - h v0, v_-1 = v0 - (v_BE - v0).
+        ImplicitOptions o;
+        o.newtonTolerance = 1e-12;
+        o.newtonPositionTolerance = 1e-300;
+        BackwardEuler pilotStep(o);
+        State pilot = before;
+        EXPECT_TRUE(pilotStep.step(model, pilot, h).ok && pilotStep.lastConverged());
+        State ghost = before;
+        ghost.x -= h * before.v;
+        ghost.v -= pilot.v - before.v;
+        return methodResidual(kind, model, ghost, before, after, h, true);
       }
       EXPECT_LE((after.x - 4.0 / 3.0 * before.x + 1.0 / 3.0 * before2.x - 2.0 / 3.0 * h * after.v)
                     .cwiseAbs()
@@ -111,11 +122,11 @@ TEST(NewtonIntegrators, AnUnconvergedStepIsRetriedAsTheTwoHalfStepsThatConverge)
   // Capped at what half a step needs, the full step cannot converge: it is retried as two
   // halves, and ends where two converged half steps taken by hand end. (Not newmark: on this
   // cube its half steps need as many iterations as its whole one, or more, from 0.01 to 0.04 s.
-  // The retry is the base class's; bdf2 is here for its history, started afresh by the halves.)
+  // Nor bdf2: its first step is two solves, a pilot and the step, so a cap cannot single out
+  // the whole step's. The retry is the base class's.)
   const SmallCube cube;
   const double h = 0.02;
-  for (IntegratorKind kind :
-       {IntegratorKind::Implicit, IntegratorKind::Midpoint, IntegratorKind::Bdf2}) {
+  for (IntegratorKind kind : {IntegratorKind::Implicit, IntegratorKind::Midpoint}) {
     SCOPED_TRACE(std::string(integratorName(kind)));
     const int full = iterationsToConverge(cube, kind, h),
               half = iterationsToConverge(cube, kind, h / 2);
@@ -226,7 +237,9 @@ TEST(NewtonIntegrators, NewtonFinishesAtRestAndOnceTheMotionStops) {
     auto method = test::makeConverged(kind);
     for (int i = 0; i < 3; ++i) {
       ASSERT_TRUE(method->step(still, r, 0.01).ok);
-      EXPECT_LE(method->lastIterations(), 1) << integratorName(kind);
+      // bdf2's first step is two solves: its backward-Euler pilot and the step.
+      const bool piloted = kind == IntegratorKind::Bdf2 && i == 0;
+      EXPECT_LE(method->lastIterations(), piloted ? 2 : 1) << integratorName(kind);
     }
   }
 

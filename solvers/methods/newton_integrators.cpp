@@ -154,7 +154,13 @@ StepResult NewtonIntegrator::step(const Model& model, State& s, double h) {
   bind(model);
   stepUnconverged_ = false;
   int iterations = 0;
-  StepResult res = advance(model, s, h, 0, iterations);
+  StepResult res = StepResult::success();
+  if (wantsPilot(s, h)) {
+    State pilot = s;
+    res = advance(model, pilot, h, 0, iterations);
+    if (res.ok) piloted(s, pilot, h);
+  }
+  if (res.ok) res = advance(model, s, h, 0, iterations);
   lastIterations_ = iterations;
   lastConverged_ = !stepUnconverged_;
   iterations_ += iterations;
@@ -355,10 +361,29 @@ void Newmark::form(const Model& model, const State& s, double h, ImplicitStepFor
   f.vNewConst = -s.v;
 }
 
+bool Bdf2::continues(const State& s, double h) const {
+  return history_ && h == h_ && s.t == last_.t && s.x == last_.x && s.v == last_.v;
+}
+
+bool Bdf2::wantsPilot(const State& s, double h) const {
+  return !continues(s, h);
+}
+
+// The history behind `start` (newton_integrators.h): x_-1 = x0 - h v0, v_-1 = v0 - h a with
+// the pilot's acceleration a = (v_BE - v0)/h.
+void Bdf2::piloted(const State& start, const State& pilot, double h) {
+  previous_ = start;
+  previous_.t = start.t - h;
+  previous_.x -= h * start.v;
+  previous_.v -= pilot.v - start.v;
+  last_ = start;
+  h_ = h;
+  history_ = true;
+}
+
 void Bdf2::form(const Model&, const State& s, double h, ImplicitStepForm& f) {
-  const bool continues = history_ && h == h_ && s.t == last_.t && s.x == last_.x && s.v == last_.v;
   current_ = s;  // the step's start: the history after it is accepted
-  if (!continues) {
+  if (!continues(s, h)) {
     backwardEulerForm(s, h, f);
     return;
   }

@@ -12,18 +12,23 @@
 //   bdf2      second-order BDF     gamma 9/4, theta 1,   v_e = (3 y - 4 x1 + x0)/(2h) = v_new,
 //                                  y_pred = (4 x1 - x0)/3 + 2h/9 (4 v1 - v0)
 //             (x1, v1 the current state, x0, v0 the one before). The first step, and any step
-//             after a change of h, of the model or of the state from outside, is a
-//             backward-Euler step. (Second-order starts were tried on the spinning stretched
-//             stiff cube, 0.2 s: a trapezoidal start carried the trapezoidal rule's energy gain
-//             into BDF2, which then kept 16% of the angular momentum; an implicit-midpoint
-//             start left the stiff modes it excites undamped and BDF2 ended with 111.6%. The
-//             backward-Euler start keeps 98.74%, its first step costing 2.5%. Tried since:
-//             the first step in m backward-Euler-started BDF2 sub-steps of h/m keeps 98.85%
-//             (k = 1e4) and 98.77% (1e5) at m = 2, less at m = 4 and 8 (98.0-98.5%); a
-//             constant-velocity history, x_-1 = x0 - h v0, v_-1 = v0, keeps 100.03% but makes
-//             BDF2 first order (its v_-1 is O(h) off); the Taylor history with h a0 blows up
-//             on the stiff modes. The loss is all in the first three steps, as the stiff
-//             vibration is damped.)
+//             after a change of h, of the model or of the state from outside, starts from a
+//             history made up behind the start: x_-1 = x0 - h v0, v_-1 = v0 - h a, with a =
+//             (v_BE - v0)/h the acceleration of a backward-Euler pilot step of h (bounded on
+//             stiff modes, where a0 itself is not). Both are O(h^2) off, so BDF2 stays second
+//             order; the pilot costs one more Newton solve per start; the halves of an
+//             unconverged step start by backward Euler. Measured on the spinning stretched stiff
+//             cube (0.2 s, k = 1e4 and 1e5), the angular momentum kept by each start:
+//               backward Euler (before)                     98.74% (its first step costs 2.5%)
+//               this history                                100.03%
+//               the same with x_-1 += h^2/2 a                100.69%
+//               v_-1 = v0 (constant velocity)                100.03%, but first order
+//               Taylor, a = a0                               blows up on the stiff modes
+//               m backward-Euler-started BDF2 sub-steps      98.85% at m = 2, 98.0-98.5% at 4, 8
+//               trapezoidal                                  16% (its energy gain carried on)
+//               implicit midpoint                            111.6% (stiff modes left undamped)
+//             Every start's loss or gain is in its first three steps, as the stiff vibration
+//             is damped.
 // Newton: J = dr/dy = gamma/h^2 M - theta K - sigma D, solved as
 //   (M - (sigma h^2/gamma) D - (theta h^2/gamma) K) delta = -(h^2/gamma) r
 // By default the factorization of that matrix is kept across iterations and steps (modified
@@ -49,8 +54,8 @@
 // that reaches newtonMaxIterations is retried as two half steps of h/2 (each retried so in turn,
 // down to h / 2^newtonHalvings: a contact whose onset the full step jumped over is met by the
 // halves); a sub-step still unconverged at that floor is accepted, counted, and the step returns
-// StepResult::unconverged, never silent. bdf2's halves are started by backward Euler (another h).
-// With barrier contact (src/world/contact_law.h) the guess and every update are bounded so
+// StepResult::unconverged, never silent. bdf2's halves start by backward Euler (another h, no
+// pilot). With barrier contact (src/world/contact_law.h) the guess and every update are bounded so
 // that no point (neither y nor x_e) reaches a solid: the line search starts at 0.9 of the
 // largest feasible step, and the merit, infinite inside, rejects the rest (Li et al. 2020).
 // Optionally (seedIterations) Newton starts where a few iterations with the constant projective
@@ -107,6 +112,15 @@ class NewtonIntegrator : public Integrator {
   virtual void form(const Model& model, const State& state, double h, ImplicitStepForm& f) = 0;
   // Called with the state an accepted step ended at (history for multistep methods).
   virtual void accepted(const State& after, double h) { (void)after, (void)h; }
+  // A multistep method without history for a step of h from `state` may ask for a pilot: the
+  // step its form gives then (bdf2: backward Euler), taken first and handed to piloted(), after
+  // which the step is taken again with what the method made of it.
+  virtual bool wantsPilot(const State& state, double h) const {
+    return (void)state, (void)h, false;
+  }
+  virtual void piloted(const State& start, const State& pilot, double h) {
+    (void)start, (void)pilot, (void)h;
+  }
 
  private:
   void bind(const Model& model);
@@ -182,7 +196,8 @@ class Newmark final : public NewtonIntegrator {
   Eigen::VectorXd a0_;
 };
 
-// bdf2: second-order backward differentiation, started by backward Euler.
+// bdf2: second-order backward differentiation, started from a history a backward-Euler pilot
+// step makes up (above).
 class Bdf2 final : public NewtonIntegrator {
  public:
   using NewtonIntegrator::NewtonIntegrator;
@@ -192,8 +207,12 @@ class Bdf2 final : public NewtonIntegrator {
  protected:
   void form(const Model& model, const State& state, double h, ImplicitStepForm& f) override;
   void accepted(const State& after, double h) override;
+  bool wantsPilot(const State& state, double h) const override;
+  void piloted(const State& start, const State& pilot, double h) override;
 
  private:
+  // True when a step of h from `state` continues the last one (the history holds).
+  bool continues(const State& state, double h) const;
   bool history_ = false;
   // The state before the last step, the current step's start, and the last step's result.
   State previous_, current_, last_;

@@ -69,7 +69,8 @@ constexpr bool isAStable(LinearModel model) {
     "implicit midpoint: symplectic, second order, no artificial damping")                        \
   X(Newmark, "newmark", "newmark", Newmark, Newton, Trapezoidal,                                 \
     "average-acceleration Newmark (trapezoidal rule): second order, A-stable")                   \
-  X(Bdf2, "bdf2", "bdf2", Bdf2, Newton, Bdf2, "second-order BDF, started by backward Euler")     \
+  X(Bdf2, "bdf2", "bdf2", Bdf2, Newton, Bdf2,                                                    \
+    "second-order BDF, started from a backward-Euler pilot")                                     \
   X(Projective, "projective", "projective", ProjectiveIntegrator, Projective, BackwardEuler,     \
     "backward Euler by prefactored local/global iterations (projective dynamics)")               \
   X(EnergyMomentum, "energy-momentum", "energy-momentum", EnergyMomentum, Newton, Trapezoidal,   \
