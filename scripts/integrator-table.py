@@ -68,7 +68,8 @@ REFERENCE = ("rk4", 1e-4, [])
 VARIANT_RUNS = {
     "implicit": [["--linear-solver", "cholmod"],
                  ["--preconditioner", "projective", "--newton-seed", "60",
-                  "--newton-seed-tol", "1e-8", "--newton-seed-chebyshev", "0.9"]],
+                  "--newton-seed-tol", "1e-8", "--newton-seed-chebyshev", "0.9",
+                  "--clamp-on-demand", "--no-factor-reuse"]],
 }
 
 

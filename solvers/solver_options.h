@@ -29,8 +29,9 @@ struct ImplicitOptions {
   double refactorRatio = 0.5;
   // Seed iterations: before Newton, up to this many iterations d <- d - P^-1 (h^2/gamma) r(d)
   // with the projective matrix P = M + L(a c + b k) (solvers/system/spring_laplacian.h), factored
-  // once per step size; each costs a force evaluation and a back-substitution, no assembly. They
-  // stop at the first iterate in contact (P does not bound the penalty springs). 0: none.
+  // once per step size; each costs a force evaluation and a back-substitution, no assembly.
+  // Light contacts are corrected on a coarse lattice; at a heavy one, the barrier or friction
+  // they stop (solvers/system/implicit_system.h, lightContactsAt). 0: none.
   int seedIterations = 0;
   // The seeds stop at this relative residual, from where Newton converges in one or two
   // iterations; at or below newtonTolerance they may converge the step themselves (with
@@ -44,7 +45,12 @@ struct ImplicitOptions {
   int contactNewtonIterations = 4;
   double contactNewtonTolerance = 1e-4;
   bool clampCompression = true;  // project each spring's Hessian onto semidefinite matrices
-  double cgTolerance = 1e-6;     // relative residual of the CG solves
+  // The converged integrators: the exact Jacobian first, the clamp only where it fails (the
+  // solve meets negative curvature or a non-positive pivot, or its update does not descend),
+  // and then for the rest of the step. Newton on the clamped Jacobian converges only linearly
+  // where springs are compressed. Overrides clampCompression for them.
+  bool clampOnDemand = false;
+  double cgTolerance = 1e-6;  // relative residual of the CG solves
 
   LinearSolverOptions linearSolverOptions() const {
     return {linearSolver, cgTolerance, preconditioner, matrixFree};

@@ -46,7 +46,7 @@ std::string describeResidual(double residual, double scale);
     "iterations")                                                                          \
   X(Projective, "projective",                                                              \
     "the springs' Laplacian M + L(a c + b k) with the contacts on its diagonal, factored " \
-    "once per step size and contact set")
+    "once per step size and again when a heavy contact comes or goes")
 
 enum class LinearSolverKind {
 #define JELLO_LINEAR_SOLVER_ENUMERATOR(kind, name, summary) kind,

@@ -44,7 +44,7 @@ void midpointForm(const State& s, double h, ImplicitStepForm& f) {
 
 NewtonIntegrator::NewtonIntegrator(const ImplicitOptions& options)
     : options_(options),
-      system_(options.linearSolverOptions(), options.clampCompression),
+      system_(options.linearSolverOptions(), options.clampCompression && !options.clampOnDemand),
       seedWeights_(options.seedChebyshevRho, kSeedChebyshevDelay) {}
 
 void NewtonIntegrator::bind(const Model& model) {
@@ -103,6 +103,31 @@ StepResult NewtonIntegrator::prepareNewtonMatrix(double h, bool refactor) {
   factorA_ = a;
   factorB_ = b;
   return StepResult::success();
+}
+
+// Newton's update into delta_ for the right-hand side in rhs_ (the matrix assembled at the
+// iterate, factored when `refactor`). Under ImplicitOptions::clampOnDemand an unclamped system
+// that fails (a non-positive pivot or curvature, an LDLT fallback) or gives an update that does
+// not descend (r.delta >= 0) is clamped, for the rest of the solve, and solved again.
+StepResult NewtonIntegrator::solveNewton(double h, bool refactor) {
+  const bool exact = options_.clampOnDemand && !system_.clampsCompression();
+  const long fallbacks = system_.solver().stats().fallbacks;
+  StepResult res = prepareNewtonMatrix(h, refactor);
+  if (res.ok) res = system_.solve(rhs_, delta_);
+  if (res.ok && !delta_.allFinite())
+    res = StepResult::failure("Newton produced a non-finite update");
+  const bool failed = !res.ok || system_.solver().stats().fallbacks != fallbacks;
+  if (exact && (failed || !(r_.dot(delta_) < 0.0))) {
+    ++clampFallbacks_;
+    system_.setClampCompression(true);
+    delta_.setZero(rhs_.size());
+    res = prepareNewtonMatrix(h, true);
+    if (res.ok) res = system_.solve(rhs_, delta_);
+    if (res.ok && !delta_.allFinite()) {
+      res = StepResult::failure("Newton produced a non-finite update");
+    }
+  }
+  return res;
 }
 
 std::pair<double, double> NewtonIntegrator::barrierStepBounds(const Model& model,
@@ -216,6 +241,10 @@ StepResult NewtonIntegrator::solve(const Model& model, const State& s, double h,
     const double bound = model.contactStepBound(form.x0.data(), d_.data());
     if (bound < 1.0) d_ *= kBarrierStepFraction * bound;
   }
+  if (options_.clampOnDemand && system_.clampsCompression()) {
+    system_.setClampCompression(false);  // the exact Jacobian again, for this solve
+    factorValid_ = false;
+  }
   converged = false;
   int k = 0;  // this solve's iterations; `iterations` sums the step's, retries included
   double previousNorm = std::numeric_limits<double>::infinity();
@@ -237,14 +266,12 @@ StepResult NewtonIntegrator::solve(const Model& model, const State& s, double h,
     const double norm = r_.norm();
     const bool refactor = !options_.reuseFactor || norm > options_.refactorRatio * previousNorm;
     previousNorm = norm;
-    if (StepResult res = prepareNewtonMatrix(h, refactor); !res.ok) return res;
     // CG solves to its own tolerance every time. An inexact-Newton forcing term (sqrt of the
     // relative residual) was tried: twice as fast on the spinning cube, but Newton then lands
     // just under its tolerance instead of far below it, which broke a uniform push's F/m
     // acceleration of the centre (2e-6 off) and left midpoint steps unconverged at a 1e-13
     // tolerance; not kept.
-    if (StepResult res = system_.solve(rhs_, delta_); !res.ok) return res;
-    if (!delta_.allFinite()) return StepResult::failure("Newton produced a non-finite update");
+    if (StepResult res = solveNewton(h, refactor); !res.ok) return res;
     // The barrier: no step may carry y, or x_e, into a solid; the line search starts at a
     // fraction of the largest step that keeps them out (Li et al. 2020's filtered line search).
     double alphaMax = 1.0;
@@ -338,6 +365,7 @@ std::vector<Statistic> NewtonIntegrator::statistics() const {
       {"seed_iterations", static_cast<double>(seeds_)},
       {"seed_chebyshev_restarts", static_cast<double>(seedWeights_.restarts())},
   };
+  if (options_.clampOnDemand) stats.emplace_back("clamp_fallbacks", double(clampFallbacks_));
   system_.appendStatistics(stats);
   return stats;
 }

@@ -130,6 +130,8 @@ class NewtonIntegrator : public Integrator {
   // Assembles K and D at the iterate and, when `refactor`, factors
   // A = M - (sigma h^2/gamma) D - (theta h^2/gamma) K there.
   StepResult prepareNewtonMatrix(double h, bool refactor);
+  // prepareNewtonMatrix, then the update into delta_ (clamped on demand: see the .cpp).
+  StepResult solveNewton(double h, bool refactor);
   // The barrier's bounds on a Newton update delta from d: the largest s <= 1 with y, and with
   // x_e, outside every solid along s delta (Model::contactStepBound).
   std::pair<double, double> barrierStepBounds(const Model& model, const Eigen::VectorXd& d,
@@ -156,7 +158,8 @@ class NewtonIntegrator : public Integrator {
   bool lastConverged_ = true;
   long steps_ = 0, iterations_ = 0, maxIterations_ = 0, cuts_ = 0, searchFailures_ = 0,
        unconverged_ = 0, retries_ = 0, reuses_ = 0, seeds_ = 0;
-  long extended_ = 0;  // solves past the cap while converging (solvers/methods/newton_cap.h)
+  long extended_ = 0;        // solves past the cap while converging (solvers/methods/newton_cap.h)
+  long clampFallbacks_ = 0;  // updates solved again clamped (ImplicitOptions::clampOnDemand)
   bool stepUnconverged_ = false;  // a sub-step of the current step was accepted unconverged
   ChebyshevWeights seedWeights_;  // the seed iterations' (ImplicitOptions::seedChebyshevRho)
 };

@@ -74,7 +74,9 @@ StepResult ImplicitSystem::factorize() {
   if (solver_.kind() == LinearSolverKind::Cg &&
       solver_.preconditioner() == PreconditionerKind::Projective) {
     contactDiagonal(*model_, x_.data(), a_, b_, contact_);
-    if (StepResult res = factorProjective(a_, b_, &contact_); !res.ok) return res;
+    if (!keepsProjective(contact_)) {
+      if (StepResult res = factorProjective(a_, b_, &contact_); !res.ok) return res;
+    }
   }
   return solver_.factorize(A_, operator_.get(), projective_.get());
 }
@@ -123,6 +125,18 @@ StepResult ImplicitSystem::factorProjective(double a, double b, const Eigen::Vec
     projectiveContact_ = *contact;
   }
   return StepResult::success();
+}
+
+// As a preconditioner, P may lack light contacts (or hold stale ones): it stays SPD and close
+// to A, so CG converges as fast, and P is not refactored at each contact change.
+bool ImplicitSystem::keepsProjective(const Eigen::VectorXd& contact) {
+  if (!coarse_ || !projective_ || !projective_->factored() || a_ != projectiveA_ ||
+      b_ != projectiveB_) {
+    return false;
+  }
+  preconditionerDifference_ = contact;
+  if (projectiveContact_.size() > 0) preconditionerDifference_ -= projectiveContact_;
+  return coarse_->light(preconditionerDifference_);
 }
 
 StepResult ImplicitSystem::factorProjectiveForSeeds(double a, double b) {

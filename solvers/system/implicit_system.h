@@ -55,7 +55,10 @@ class ImplicitSystem {
   // preconditioner and Newton's seed iterations. C, diagonal, bounds the contact springs' part of
   // A: per point in contact, b kc + a dc for each wall, the plane, the sphere and each obstacle
   // it is inside of (kc n n^T <= kc I), given as `contact` (n values, null: none). factorize()
-  // sets P up itself for CG, with the contacts of the last assembly's positions.
+  // sets P up itself for CG, with the contacts of the last assembly's positions, keeping the
+  // factor it has while they differ from its C by light contacts only (lightContactsAt's test:
+  // P stays SPD and close to A, and CG converged as fast on jello.w, without a factorization
+  // at each contact change).
   StepResult factorProjective(double a, double b, const Eigen::VectorXd* contact = nullptr);
   // P(a, b) for Newton's seeds: the factor kept when it is for a and b, whatever C it holds
   // (the preconditioner's contacts: lightContactsAt corrects for the difference); else
@@ -76,6 +79,10 @@ class ImplicitSystem {
   const SparseMatrix& K() const { return jacobian_->K(); }
   const SparseMatrix& D() const { return jacobian_->D(); }
   double frictionQuadratic(const double* v) const { return jacobian_->frictionQuadratic(v); }
+  // Whether the next assembly projects compressed springs' Hessians (the clamp).
+  void setClampCompression(bool clamp) { clampCompression_ = clamp; }
+  bool clampsCompression() const { return clampCompression_; }
+
   const SparseMatrix& A() const { return A_; }
   const SpdSolver& solver() const { return solver_; }
   long clampCount() const { return jacobian_ ? jacobian_->totalClampCount() : 0; }
@@ -85,6 +92,9 @@ class ImplicitSystem {
   void appendStatistics(std::vector<Statistic>& out) const;
 
  private:
+  // True when P, factored for the current a and b, differs from P with `contact` by light
+  // contacts only (see factorize()).
+  bool keepsProjective(const Eigen::VectorXd& contact);
   bool clampCompression_;
   long modelId_ = -1;
   const Model* model_ = nullptr;  // the one of the last bind: alive while a step runs
@@ -104,6 +114,7 @@ class ImplicitSystem {
   // wanted C and its difference from P's (lightContactsAt), and whether there is one to correct.
   std::unique_ptr<LatticeCoarseSpace> coarse_;
   Eigen::VectorXd wantedContact_, contactDifference_;
+  Eigen::VectorXd preconditionerDifference_;  // keepsProjective's
   SparseMatrix freeMatrix_;
   bool correctContacts_ = false;
   long projectiveFactorizations_ = 0;
