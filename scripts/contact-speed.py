@@ -8,13 +8,16 @@ benchmarks_implicit.cpp: 30 steps at dt = 0.01 from jello.w's start, the cube me
 and the plane, wall time per step after the first) on one core of the native build with
 single-threaded BLAS and CHOLMOD, and writes Google Benchmark's JSON to
 experiments/results/contact_speed.json; with --only, those of one integrator, replacing its
-entries in that file and keeping the others' (implicit at 16^3 takes ten minutes). Without it,
+entries in that file and keeping the others' (implicit at 16^3 takes ten minutes); with --n, those
+of one cube size (implicit_fast, the seeded Newton on the exact Jacobian, is measured at 8^3:
+at 16^3 jello.w's impacts cost it about 50 Newton iterations a step). Without it,
 prints the README's table (block
 contact-speed, which scripts/results-tables.py writes from that file alone).
 """
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -23,19 +26,23 @@ JSON = os.path.join(ROOT, "experiments", "results", "contact_speed.json")
 BINARY = os.path.join(ROOT, "build", "native", "bin", "benchmarks")
 
 
-def run(only=None):
+# The benchmarks' integrator names and how the table shows them.
+LABELS = {"implicit_fast": "`implicit`, fast (seeded, exact Jacobian)"}
+
+
+def run(only=None, n=None):
     env = dict(os.environ, OMP_THREAD_LIMIT="1", OPENBLAS_NUM_THREADS="1")
     tmp = JSON + ".tmp"
-    name = "BM_ContactRun/" + (only + "/" if only else "")
-    subprocess.run(["taskset", "-c", "0", BINARY, f"--benchmark_filter={name}",
+    pattern = "BM_ContactRun/" + (only + "/" if only else "") + (f".*/N:{n}/" if n else "")
+    subprocess.run(["taskset", "-c", "0", BINARY, f"--benchmark_filter={pattern}",
                     f"--benchmark_out={tmp}", "--benchmark_out_format=json"],
                    check=True, env=env)
-    if only and os.path.exists(JSON):
+    if (only or n) and os.path.exists(JSON):
         with open(tmp) as f:
             fresh = json.load(f)
         with open(JSON) as f:
             kept = json.load(f)["benchmarks"]
-        fresh["benchmarks"] = ([b for b in kept if not b["name"].startswith(name)] +
+        fresh["benchmarks"] = ([b for b in kept if not re.match(pattern, b["name"])] +
                                fresh["benchmarks"])
         with open(tmp, "w") as f:
             json.dump(fresh, f, indent=2)
@@ -78,7 +85,9 @@ def table(path=JSON):
                          f"{plural(b.get('factor_updates', 0), 'update')}, "
                          f"{plural(b.get('coarse_corrections', 0), 'coarse correction')}")
                 cells.append(f"{ms:.3g} ms ({extra})")
-            lines.append(f"| `{integrator}` | {n}^3 | " + " | ".join(cells) + " |")
+            if any(cells):
+                shown = LABELS.get(integrator, f"`{integrator}`")
+                lines.append(f"| {shown} | {n}^3 | " + " | ".join(cells) + " |")
     ctx = data["context"]
     lines.append("")
     lines.append(f"Wall time per step over jello.w's first 30 steps at dt = 0.01 s (its cube "
@@ -94,13 +103,15 @@ def table(path=JSON):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--run", action="store_true", help="measure again (about 15 minutes)")
-    parser.add_argument("--only", choices=["projective", "implicit"],
-                        help="with --run: measure this integrator alone, keep the other's")
+    parser.add_argument("--only", choices=["projective", "implicit", "implicit_fast"],
+                        help="with --run: measure this integrator alone, keep the others'")
+    parser.add_argument("--n", type=int, choices=[8, 16],
+                        help="with --run: measure this cube size alone, keep the others'")
     args = parser.parse_args()
     if args.run:
         if not os.path.exists(BINARY):
             sys.exit(f"contact-speed: no {BINARY}: build the native preset first")
-        run(args.only)
+        run(args.only, args.n)
     print(table())
 
 

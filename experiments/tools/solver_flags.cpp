@@ -95,10 +95,12 @@ void addSolverFlags(CLI::App& app, SolverFlags& f) {
              "factor afresh when an iteration shrinks "
              "the residual by less than this")
       ->check(cli::range(1e-6, 1.0));
-  option("--newton-seed", implicit.seedIterations,
-         newton +
-             "iterations with the constant projective "
-             "matrix before Newton (stopped at the first iterate in contact; 0: none)")
+  option(
+      "--newton-seed", implicit.seedIterations,
+      newton +
+          "iterations with the constant projective "
+          "matrix before Newton (through light contacts, corrected on a coarse lattice; stopped at "
+          "a heavy one, the barrier or friction; 0: none)")
       ->check(cli::range(0, 1000));
   option("--newton-seed-tol", implicit.seedTolerance,
          newton +
