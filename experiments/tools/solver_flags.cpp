@@ -63,9 +63,8 @@ void addSolverFlags(CLI::App& app, SolverFlags& f) {
   flag("--no-clamp", f.noClamp,
        "Do not clamp compressed springs' Jacobians (the system may be indefinite)");
   flag("--clamp-on-demand", implicit.clampOnDemand,
-       newton +
-           "Newton on the exact Jacobian, clamped only where its solve fails or its update "
-           "does not descend (then for the rest of the step)");
+       "implicit, midpoint, newmark, bdf2: Newton on the exact Jacobian, clamped only where "
+       "its solve fails or its update does not descend (then for the rest of the step)");
   option("--cg-tol", implicit.cgTolerance, "Relative residual of CG solves")
       ->check(cli::positive());
   option("--newton-iters", implicit.newtonMaxIterations,
