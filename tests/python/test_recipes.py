@@ -38,6 +38,7 @@ DEFINE_OR_PICK = {
     "solvers/methods/newton_integrators.h",
     "experiments/studies/study_integrators.cpp",
     "experiments/bench/benchmarks_implicit.cpp",
+    "experiments/bench/benchmarks_one_second.cpp",
     # The reference, and the quick run's picks (Newton's first- and second-order steps).
     "experiments/python/energy_over_time.py",
     # The reference and implicit's variants ('projective' there is the preconditioner).
