@@ -110,22 +110,22 @@ StepResult NewtonIntegrator::prepareNewtonMatrix(double h, bool refactor) {
 // that fails (a non-positive pivot or curvature, an LDLT fallback) or gives an update that does
 // not descend (r.delta >= 0) is clamped, for the rest of the solve, and solved again.
 StepResult NewtonIntegrator::solveNewton(double h, bool refactor) {
+  const auto attempt = [&](bool fresh) {
+    StepResult res = prepareNewtonMatrix(h, fresh);
+    if (res.ok) res = system_.solve(rhs_, delta_);
+    if (res.ok && !delta_.allFinite())
+      res = StepResult::failure("Newton produced a non-finite update");
+    return res;
+  };
   const bool exact = options_.clampOnDemand && !system_.clampsCompression();
   const long fallbacks = system_.solver().stats().fallbacks;
-  StepResult res = prepareNewtonMatrix(h, refactor);
-  if (res.ok) res = system_.solve(rhs_, delta_);
-  if (res.ok && !delta_.allFinite())
-    res = StepResult::failure("Newton produced a non-finite update");
+  StepResult res = attempt(refactor);
   const bool failed = !res.ok || system_.solver().stats().fallbacks != fallbacks;
   if (exact && (failed || !(r_.dot(delta_) < 0.0))) {
     ++clampFallbacks_;
     system_.setClampCompression(true);
     delta_.setZero(rhs_.size());
-    res = prepareNewtonMatrix(h, true);
-    if (res.ok) res = system_.solve(rhs_, delta_);
-    if (res.ok && !delta_.allFinite()) {
-      res = StepResult::failure("Newton produced a non-finite update");
-    }
+    res = attempt(true);
   }
   return res;
 }

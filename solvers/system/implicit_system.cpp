@@ -134,9 +134,14 @@ bool ImplicitSystem::keepsProjective(const Eigen::VectorXd& contact) {
       b_ != projectiveB_) {
     return false;
   }
-  preconditionerDifference_ = contact;
-  if (projectiveContact_.size() > 0) preconditionerDifference_ -= projectiveContact_;
-  return coarse_->light(preconditionerDifference_);
+  return lightAgainstFactor(contact, preconditionerDifference_);
+}
+
+bool ImplicitSystem::lightAgainstFactor(const Eigen::VectorXd& contact,
+                                        Eigen::VectorXd& difference) const {
+  difference = contact;
+  if (projectiveContact_.size() > 0) difference -= projectiveContact_;
+  return coarse_->light(difference);
 }
 
 StepResult ImplicitSystem::factorProjectiveForSeeds(double a, double b) {
@@ -154,9 +159,7 @@ bool ImplicitSystem::lightContactsAt(const double* x) {
   // seeds stop at their contacts, as they do without a lattice.
   if (!coarse_ || model.barrierContact() || model.hasFriction()) return !model.inContact(x);
   contactDiagonal(model, x, projectiveA_, projectiveB_, wantedContact_);
-  contactDifference_ = wantedContact_;
-  if (projectiveContact_.size() > 0) contactDifference_ -= projectiveContact_;
-  if (!coarse_->light(contactDifference_)) return false;
+  if (!lightAgainstFactor(wantedContact_, contactDifference_)) return false;
   correctContacts_ = !contactDifference_.isZero(0.0);
   return true;
 }

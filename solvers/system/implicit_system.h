@@ -95,6 +95,8 @@ class ImplicitSystem {
   // True when P, factored for the current a and b, differs from P with `contact` by light
   // contacts only (see factorize()).
   bool keepsProjective(const Eigen::VectorXd& contact);
+  // difference = contact - the C P holds; true when every entry is light (coarse_'s test).
+  bool lightAgainstFactor(const Eigen::VectorXd& contact, Eigen::VectorXd& difference) const;
   bool clampCompression_;
   long modelId_ = -1;
   const Model* model_ = nullptr;  // the one of the last bind: alive while a step runs
