@@ -28,7 +28,7 @@ JSON = os.path.join(ROOT, "experiments", "results", "speed.json")
 THREADS_JSON = os.path.join(ROOT, "experiments", "results", "speed_threads.json")
 # The native build (-march=native): the README's speed figures are this machine's best.
 BINARY = os.path.join(ROOT, "build", "native", "bin", "benchmarks")
-FILTER = ("BM_SpringForces|BM_Step/|BM_Refill|BM_Factorize|BM_Solve/|BM_CgSolve|BM_SystemProduct|"
+FILTER = ("BM_SpringForces|BM_Step/|BM_Refill|BM_OperatorFill|BM_Factorize|BM_Solve/|BM_CgSolve|BM_SystemProduct|"
           "BM_ImplicitStep/|BM_StiffOneSecond")
 # BM_CgSolve's preconditioner argument is its row in the table (solvers/linalg/linear_solver.h).
 PRECONDITIONERS = [r["name"] for r in closed_sets.preconditioners()]
@@ -110,6 +110,12 @@ def implicit_table(r):
              " | ".join(grouped(r.get(f"BM_Refill/{n}")["nonzeros"]) for n in ns) + " |",
              "| refill K and D in place | " +
              " | ".join(fmt_time(r.seconds(f"BM_Refill/{n}")) for n in ns) + " |",
+             "| CG's operator of A: K and D refilled, combined, gathered | " +
+             " | ".join(fmt_time(r.seconds(f"BM_OperatorFill/N:{n}/filled:0")) for n in ns) +
+             " |",
+             "| **CG's operator of A filled straight from the springs** (Newton's) | " +
+             " | ".join(fmt_time(r.seconds(f"BM_OperatorFill/N:{n}/filled:1")) for n in ns) +
+             " |",
              "| CHOLMOD supernodal factorization | " +
              " | ".join(fmt_time(r.seconds(f"BM_Factorize/{n}")) for n in ns) + " |",
              "| CHOLMOD solve | " +

@@ -164,7 +164,7 @@ void Model::acceleration(const Eigen::VectorXd& x, const Eigen::VectorXd& v,
 }
 
 void Model::addJacobian(const double* x, JacobianBlocks& out) const {
-  springs_.addJacobian(x, out);
+  if (out.includeSprings) springs_.addJacobian(x, out);
   for (const auto& o : obstacles_) {
     o->addJacobian(x, n_, out);
     if (friction_ && out.velocities) {

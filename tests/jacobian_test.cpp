@@ -212,6 +212,28 @@ TEST(AssembledJacobian, ClampedSystemIsPositiveDefiniteForAnyStep) {
   EXPECT_EQ(Eigen::LLT<Eigen::MatrixXd>(Eigen::MatrixXd(A)).info(), Eigen::Success);
 }
 
+// One system of the test below: A against K and D, a solve, v^T D v, and bind's answers.
+void solvesTheScaledJacobians(ImplicitSystem& system, const Model& model, const Model& other,
+                              const State& s) {
+  EXPECT_TRUE(system.bind(model));
+  EXPECT_FALSE(system.bind(model));
+  system.assemble(s.x.data(), s.v.data());
+  const double a = 0.02, b = 4e-4;
+  ASSERT_TRUE(system.factorize(a, b).ok);
+  const double quadratic = system.dampingQuadratic(s.v);  // before D is formed
+  const Eigen::Index n3 = s.x.size();
+  const Eigen::MatrixXd A = model.mass() * Eigen::MatrixXd::Identity(n3, n3) -
+                            a * Eigen::MatrixXd(system.D()) - b * Eigen::MatrixXd(system.K());
+  EXPECT_LT((Eigen::MatrixXd(system.A()) - A).cwiseAbs().maxCoeff(), 1e-12 * A.norm());
+  const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(n3, -1.0, 2.0);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n3);
+  ASSERT_TRUE(system.solve(rhs, x).ok);
+  EXPECT_LT((A * x - rhs).norm(), 1e-10 * rhs.norm());
+  const Eigen::VectorXd Dv = system.D() * s.v;
+  EXPECT_NEAR(quadratic, s.v.dot(Dv), 1e-12 * std::abs(s.v.dot(Dv)));
+  EXPECT_TRUE(system.bind(other));  // another model, even one built from the same world
+}
+
 // The shared implicit system solves M - a D - b K (M = m I) at the assembled state: the solution
 // checked against a dense matrix built from K and D by the test, and binding reports a new
 // model once.
@@ -230,26 +252,96 @@ TEST(ImplicitSystem, SolvesTheMassMinusScaledJacobiansAtTheAssembledState) {
       solvers.push_back({LinearSolverKind::Cg, 1e-11, pre, matrixFree});
     }
   }
+  // Each also with the operator filled straight from the springs (where it applies: matrix-free
+  // CG, jacobi, block-jacobi, projective), K, D and A then formed only when asked for below.
   for (const LinearSolverOptions& options : solvers) {
-    SCOPED_TRACE(std::string(linearSolverName(options.kind)) + " " +
-                 std::string(preconditionerName(options.preconditioner)) +
-                 (options.matrixFree ? " matrix-free" : " csr"));
-    ImplicitSystem system(options, true);
-    EXPECT_TRUE(system.bind(model));
-    EXPECT_FALSE(system.bind(model));
-    system.assemble(s.x.data(), s.v.data());
-    const double a = 0.02, b = 4e-4;
-    ASSERT_TRUE(system.factorize(a, b).ok);
-    const Eigen::Index n3 = s.x.size();
-    const Eigen::MatrixXd A = model.mass() * Eigen::MatrixXd::Identity(n3, n3) -
-                              a * Eigen::MatrixXd(system.D()) - b * Eigen::MatrixXd(system.K());
-    EXPECT_LT((Eigen::MatrixXd(system.A()) - A).cwiseAbs().maxCoeff(), 1e-12 * A.norm());
-    const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(n3, -1.0, 2.0);
-    Eigen::VectorXd x = Eigen::VectorXd::Zero(n3);
-    ASSERT_TRUE(system.solve(rhs, x).ok);
-    EXPECT_LT((A * x - rhs).norm(), 1e-10 * rhs.norm());
-    EXPECT_TRUE(system.bind(other));  // another model, even one built from the same world
+    for (bool direct : {false, true}) {
+      SCOPED_TRACE(std::string(linearSolverName(options.kind)) + " " +
+                   std::string(preconditionerName(options.preconditioner)) +
+                   (options.matrixFree ? " matrix-free" : " csr") + (direct ? ", direct" : ""));
+      ImplicitSystem system(options, true, direct);
+      EXPECT_EQ(system.fillsDirectly(), direct && options.kind == LinearSolverKind::Cg &&
+                                            options.matrixFree &&
+                                            !preconditionerNeedsMatrix(options.preconditioner));
+      solvesTheScaledJacobians(system, model, other, s);
+    }
   }
+}
+
+// Filled straight from the springs, the operator holds the assembled matrix's values: its
+// product, diagonal blocks and clamp count on the sinking jello (springs compressed and stretched,
+// contact on the diagonal), with the clamp and without.
+TEST(SystemOperator, FilledFromTheSpringsEqualsTheAssembledMatrix) {
+  World w = test::loadWorld("jello.w");
+  State s = deformedJello(w);
+  s.x.tail(s.numPoints()).array() -= 2.3;
+  s.x.head(2 * s.numPoints()) *= 0.8;  // some springs compressed
+  const Model model(w);
+  for (bool clamp : {true, false}) {
+    SCOPED_TRACE(clamp ? "clamped" : "unclamped");
+    JacobianAssembler full(model), others(model);
+    full.assemble(s.x.data(), {.clampCompression = clamp, .velocities = s.v.data()});
+    others.assemble(s.x.data(),
+                    {.clampCompression = clamp, .velocities = s.v.data(), .includeSprings = false});
+    SparseMatrix A = full.pattern();
+    const double a = 0.01, b = 1e-4;
+    full.combine(a, b, A);
+    SystemOperator gathered(model.springs(), model.numPoints()),
+        filled(model.springs(), model.numPoints());
+    gathered.gather(A, full.diagonalSlots(), full.springSlots());
+    const long clamps = filled.fill(s.x.data(), model.mass(), a, b, clamp,
+                                    others.diagonalK().data(), others.diagonalD().data());
+    EXPECT_EQ(clamps, full.lastClampCount());
+    if (clamp) {
+      EXPECT_GT(clamps, 100);
+    }
+    const Eigen::VectorXd p = Eigen::VectorXd::Random(s.x.size());
+    Eigen::VectorXd y(p.size());
+    filled.apply(p.data(), y.data());
+    const Eigen::VectorXd expected = A * p;
+    EXPECT_LT((y - expected).cwiseAbs().maxCoeff(), 1e-12 * expected.cwiseAbs().maxCoeff());
+    for (int e = 0; e < 6; ++e) {
+      for (int q = 0; q < model.numPoints(); ++q) {
+        EXPECT_NEAR(filled.diagonalBlocks()[e][q], gathered.diagonalBlocks()[e][q],
+                    1e-12 * model.mass() * 1e3);
+      }
+    }
+    // The springs' part of v^T D v, with the other effects' diagonal blocks added by the caller.
+    const Eigen::VectorXd Dv = full.D() * s.v;
+    double quadratic = filled.springDampingQuadratic(s.x.data(), s.v.data());
+    const std::ptrdiff_t n = model.numPoints();
+    for (std::ptrdiff_t q = 0; q < n; ++q)
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+          quadratic += s.v[r * n + q] * others.diagonalD()[9 * q + 3 * r + c] * s.v[c * n + q];
+    EXPECT_NEAR(quadratic, s.v.dot(Dv), 1e-12 * std::abs(s.v.dot(Dv)));
+  }
+}
+
+// Without the clamp the matrix of a compressed stiff jello is indefinite: CG meets a negative
+// curvature, and the directly filled system falls back to LDLT of A, formed then, as the
+// gathered one does inside its solver.
+TEST(ImplicitSystem, DirectlyFilledFallsBackToLdltWhereTheMatrixIsIndefinite) {
+  World w = test::loadWorld("jello.w");
+  w.kElastic = 1e5;
+  State s = deformedJello(w);
+  s.x *= 0.9;
+  const Model model(w);
+  ImplicitSystem system({LinearSolverKind::Cg, 1e-10, PreconditionerKind::Projective}, false, true);
+  ASSERT_TRUE(system.fillsDirectly());
+  system.bind(model);
+  system.assemble(s.x.data(), s.v.data());
+  const double a = 0.01, b = 0.01 * 0.01;
+  ASSERT_TRUE(system.factorize(a, b).ok);
+  const Eigen::Index n3 = s.x.size();
+  const Eigen::VectorXd rhs = Eigen::VectorXd::LinSpaced(n3, -1.0, 2.0);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n3);
+  const StepResult solved = system.solve(rhs, x);
+  ASSERT_TRUE(solved.ok) << solved.message;
+  EXPECT_EQ(system.solver().stats().fallbacks, 1);
+  const SparseMatrix& A = system.A();
+  EXPECT_NE(Eigen::LLT<Eigen::MatrixXd>(Eigen::MatrixXd(A)).info(), Eigen::Success);
+  EXPECT_LT((A * x - rhs).norm(), 1e-8 * rhs.norm());
 }
 
 // A deformed world whose lower layers sink into the floor (springs under every orientation,

@@ -1,5 +1,7 @@
 // Speed of the implicit machinery (Google Benchmark). Figures are reported in the README.
 //   BM_Refill/N          assemble K and D in place at a deformed state
+//   BM_OperatorFill/N/filled  A's operator for CG: gathered from the assembled sparse A (0), or
+//                        filled straight from the springs (1)
 //   BM_Factorize/N       CHOLMOD supernodal LLT of M - h D - h^2 K, h = 0.01
 //   BM_Solve/N           CHOLMOD triangular solves
 //   BM_CgSolve/N         Jacobi-CG at tolerance 1e-6, warm-started from the last step
@@ -98,6 +100,38 @@ void BM_Refill(benchmark::State& st) {
   st.counters["nonzeros"] = static_cast<double>(jac.K().nonZeros());
 }
 BENCHMARK(BM_Refill)->Arg(8)->Arg(16)->Unit(benchmark::kMicrosecond);
+
+// What a Newton iteration pays for A = M - a D - b K (a = 0.01, b = 1e-4) before CG multiplies:
+// gathered, K and D refilled, combined into A and gathered into the operator (as before; mode 0),
+// or filled, the other effects' diagonal blocks assembled and the springs' blocks filled straight
+// from the positions (SystemOperator::fill; mode 1).
+void BM_OperatorFill(benchmark::State& st) {
+  const World w = jelloAt(static_cast<int>(st.range(0)));
+  const Model model(w);
+  const State s = movingState(w);
+  JacobianAssembler jac(model);
+  SystemOperator op(model.springs(), model.numPoints());
+  SparseMatrix A = jac.pattern();
+  const bool filled = st.range(1) == 1;
+  for (auto _ : st) {
+    if (filled) {
+      JacobianOptions options;
+      options.includeSprings = false;
+      jac.assemble(s.x.data(), options);
+      benchmark::DoNotOptimize(op.fill(s.x.data(), model.mass(), 0.01, 1e-4, true,
+                                       jac.diagonalK().data(), jac.diagonalD().data()));
+    } else {
+      jac.assemble(s.x.data(), {});
+      jac.combine(0.01, 1e-4, A);
+      op.gather(A, jac.diagonalSlots(), jac.springSlots());
+    }
+    benchmark::DoNotOptimize(op.diagonalBlocks()[0]);
+  }
+}
+BENCHMARK(BM_OperatorFill)
+    ->ArgsProduct({{8, 16}, {0, 1}})
+    ->ArgNames({"N", "filled"})
+    ->Unit(benchmark::kMicrosecond);
 
 struct System {
   World w;

@@ -9,6 +9,7 @@
 
 #include "solvers/linalg/blas_headroom.h"
 #include "solvers/linalg/prefactored_cholesky.h"
+#include "src/base/assertions.h"
 #include "src/base/closed_set.h"
 
 namespace jello {
@@ -21,6 +22,15 @@ double secondsSince(Clock::time_point start) {
 }
 
 constexpr double kResidualTolerance = 1e-8;
+
+// The diagonal of the operator's matrix (3n), from its points' diagonal blocks.
+Eigen::VectorXd operatorDiagonal(const LinearOperator& op, Eigen::Index n) {
+  const std::array<const double*, 6> g = op.diagonalBlocks();
+  Eigen::VectorXd d(3 * n);
+  d << Eigen::Map<const Eigen::VectorXd>(g[0], n), Eigen::Map<const Eigen::VectorXd>(g[3], n),
+      Eigen::Map<const Eigen::VectorXd>(g[5], n);
+  return d;
+}
 
 }  // namespace
 
@@ -174,12 +184,18 @@ void SpdSolver::forgetPattern() {
   impl_->staleFactor = false;
 }
 
-StepResult SpdSolver::setUpPreconditioner(const SparseMatrix& A) {
+bool preconditionerNeedsMatrix(PreconditionerKind kind) {
+  return kind == PreconditionerKind::IncompleteCholesky || kind == PreconditionerKind::Factor;
+}
+
+StepResult SpdSolver::setUpPreconditioner(const SparseMatrix* A, Eigen::Index n3) {
   Impl& s = *impl_;
-  const Eigen::Index n3 = A.rows(), n = n3 / 3;
+  const Eigen::Index n = n3 / 3;
+  JELLO_ASSERT(A || (s.op && !preconditionerNeedsMatrix(preconditioner_)),
+               "a preconditioner without A takes the operator's");
   switch (preconditioner_) {
     case PreconditionerKind::Jacobi: {
-      const Eigen::VectorXd d = A.diagonal();
+      const Eigen::VectorXd d = s.op ? operatorDiagonal(*s.op, n) : Eigen::VectorXd(A->diagonal());
       if (!(d.minCoeff() > 0.0)) {
         return StepResult::failure("Jacobi preconditioner: a diagonal entry is not positive");
       }
@@ -196,7 +212,7 @@ StepResult SpdSolver::setUpPreconditioner(const SparseMatrix& A) {
         for (int e = 0; e < 6; ++e) {
           blocks[e].resize(n);
           for (Eigen::Index i = 0; i < n; ++i)
-            blocks[e][i] = A.coeff(rows[e] * n + i, cols[e] * n + i);
+            blocks[e][i] = A->coeff(rows[e] * n + i, cols[e] * n + i);
           g[e] = blocks[e].data();
         }
       }
@@ -207,10 +223,10 @@ StepResult SpdSolver::setUpPreconditioner(const SparseMatrix& A) {
     }
     case PreconditionerKind::IncompleteCholesky:
       if (!s.icholAnalyzed) {
-        s.ichol.analyzePattern(A);
+        s.ichol.analyzePattern(*A);
         s.icholAnalyzed = true;
       }
-      s.ichol.factorize(A);
+      s.ichol.factorize(*A);
       ++stats_.preconditionerFactorizations;
       if (s.ichol.info() != Eigen::Success) {
         return StepResult::failure("incomplete Cholesky failed");
@@ -221,7 +237,7 @@ StepResult SpdSolver::setUpPreconditioner(const SparseMatrix& A) {
         return StepResult::success();  // the earlier factor still serves
       }
       if (!s.lltAnalyzed) {
-        s.llt.analyzePattern(A);
+        s.llt.analyzePattern(*A);
         ++stats_.analyses;
         if (s.llt.info() != Eigen::Success) return StepResult::failure("CHOLMOD analysis failed");
         s.lltAnalyzed = true;
@@ -229,7 +245,7 @@ StepResult SpdSolver::setUpPreconditioner(const SparseMatrix& A) {
       if (const std::string why = blasHeadroomProblem(); !why.empty()) {
         return StepResult::resourceFailure(why);
       }
-      s.llt.factorize(A);
+      s.llt.factorize(*A);
       ++stats_.preconditionerFactorizations;
       s.lastIterations = 0;
       s.staleFactor = s.llt.info() == Eigen::Success;
@@ -375,11 +391,44 @@ StepResult SpdSolver::factorize(const SparseMatrix& A, const LinearOperator* op,
     case LinearSolverKind::Cg:
       s.op = op;
       s.projective = projective;
-      result = setUpPreconditioner(A);
+      result = setUpPreconditioner(&A, A.rows());
       break;
   }
   ++stats_.factorizations;
   stats_.factorSeconds += secondsSince(start);
+  return result;
+}
+
+StepResult SpdSolver::prepare(const LinearOperator& op, Eigen::Index n3,
+                              const PrefactoredCholesky* projective) {
+  JELLO_ASSERT(kind_ == LinearSolverKind::Cg, "only CG solves with an operator alone");
+  const auto start = Clock::now();
+  Impl& s = *impl_;
+  s.A = nullptr;
+  s.useLdlt = false;
+  s.op = &op;
+  s.projective = projective;
+  const StepResult result = setUpPreconditioner(nullptr, n3);
+  ++stats_.factorizations;
+  stats_.factorSeconds += secondsSince(start);
+  return result;
+}
+
+bool SpdSolver::indefinite() const {
+  return impl_->indefinite;
+}
+
+StepResult SpdSolver::fallBackToLdlt(const SparseMatrix& A, const Eigen::VectorXd& b,
+                                     Eigen::VectorXd& x) {
+  const auto start = Clock::now();
+  Impl& s = *impl_;
+  ++stats_.fallbacks;
+  s.A = &A;
+  StepResult result = s.factorLdlt(A, stats_);
+  s.useLdlt = result.ok;
+  if (result.ok) result = s.solveLdlt(b, x);
+  if (result.ok && !x.allFinite()) result = StepResult::failure("the solution is not finite");
+  stats_.solveSeconds += secondsSince(start);
   return result;
 }
 
@@ -392,7 +441,7 @@ StepResult SpdSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
     result = conjugateGradients(b, x);
     // Not positive definite (possible only with the clamp off): LDLT until the next factorize,
     // as cholmod falls back.
-    if (!result.ok && s.indefinite) {
+    if (!result.ok && s.indefinite && s.A) {
       ++stats_.fallbacks;
       result = s.factorLdlt(*s.A, stats_);
       s.useLdlt = result.ok;

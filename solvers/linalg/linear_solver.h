@@ -73,6 +73,9 @@ std::span<const LinearSolverKind> allLinearSolvers();
 std::optional<PreconditionerKind> parsePreconditioner(std::string_view name);
 std::string_view preconditionerName(PreconditionerKind kind);
 std::string_view preconditionerSummary(PreconditionerKind kind);
+// Whether the preconditioner is built from the sparse matrix A itself (ichol, factor), not from
+// an operator's diagonal blocks or the projective factor: SpdSolver::prepare takes the others.
+bool preconditionerNeedsMatrix(PreconditionerKind kind);
 std::span<const PreconditionerKind> allPreconditioners();
 
 // A stale factor is refreshed after a solve that took more CG iterations than this.
@@ -111,6 +114,16 @@ class SpdSolver {
   // factored Laplacian the projective preconditioner solves with (required for it).
   StepResult factorize(const SparseMatrix& A, const LinearOperator* op = nullptr,
                        const PrefactoredCholesky* projective = nullptr);
+  // cg, matrix-free, without a sparse A: prepares to solve with the matrix `op` holds (n3 rows),
+  // for the preconditioners that need no A (jacobi and block-jacobi from op's diagonal blocks,
+  // projective). A solve that meets a direction of non-positive curvature then fails with
+  // indefinite() set instead of falling back to LDLT: the caller forms A for fallBackToLdlt.
+  StepResult prepare(const LinearOperator& op, Eigen::Index n3,
+                     const PrefactoredCholesky* projective = nullptr);
+  bool indefinite() const;
+  // LDLT of A (the matrix of the last prepare, formed), counted as a fallback, then x = A^-1 b;
+  // the solves until the next factorize or prepare stay with it, as factorize's fallback does.
+  StepResult fallBackToLdlt(const SparseMatrix& A, const Eigen::VectorXd& b, Eigen::VectorXd& x);
   // The next factorize analyzes its matrix's pattern afresh (a new model).
   void forgetPattern();
   // x: on entry the initial guess (cg), on return the solution.
@@ -122,7 +135,8 @@ class SpdSolver {
 
  private:
   struct Impl;
-  StepResult setUpPreconditioner(const SparseMatrix& A);
+  // A: null where the operator holds the matrix (prepare).
+  StepResult setUpPreconditioner(const SparseMatrix* A, Eigen::Index n3);
   StepResult conjugateGradients(const Eigen::VectorXd& b, Eigen::VectorXd& x);
   LinearSolverKind kind_;
   PreconditionerKind preconditioner_ = PreconditionerKind::Jacobi;

@@ -44,7 +44,8 @@ void midpointForm(const State& s, double h, ImplicitStepForm& f) {
 
 NewtonIntegrator::NewtonIntegrator(const ImplicitOptions& options)
     : options_(options),
-      system_(options.linearSolverOptions(), options.clampCompression && !options.clampOnDemand),
+      system_(options.linearSolverOptions(), options.clampCompression && !options.clampOnDemand,
+              true),
       seedWeights_(options.seedChebyshevRho, kSeedChebyshevDelay) {}
 
 void NewtonIntegrator::bind(const Model& model) {
@@ -74,11 +75,10 @@ double NewtonIntegrator::merit(const Model& model, double inertia, const Eigen::
   xe_ = form.x0 + form.theta * d;
   ve_ = form.sigma * d + form.vConst;
   e += (model.potentialEnergy(xe_.data()) - external_.dot(xe_)) / form.theta;
-  dv_.noalias() = system_.D() * ve_;
   // Friction by its dissipation potential (convex in v; lambda and n lagged at the step's
   // start), not by the quadratic of its D at the iterate, which is flat along a slip above
   // eps_v: there the line search could not see friction at all.
-  e += (-0.5 * (ve_.dot(dv_) - system_.frictionQuadratic(ve_.data())) +
+  e += (-0.5 * (system_.dampingQuadratic(ve_) - system_.frictionQuadratic(ve_.data())) +
         model.frictionPotential(xe_.data(), ve_.data())) /
        form.sigma;
   return e;

@@ -151,7 +151,7 @@ class NewtonIntegrator : public Integrator {
   double factorA_ = 0.0, factorB_ = 0.0;
   // Workspaces: positions and velocities where forces are evaluated, force, residual, update.
   ImplicitStepForm form_;  // the current step's
-  Eigen::VectorXd d_, dTrial_, xe_, ve_, f_, r_, rhs_, delta_, trial_, external_, dv_;
+  Eigen::VectorXd d_, dTrial_, xe_, ve_, f_, r_, rhs_, delta_, trial_, external_;
   Eigen::VectorXd previousSeed_;  // the seed iterate before d_ (Chebyshev)
   int lastIterations_ = 0;
   double lastResidual_ = 0.0;

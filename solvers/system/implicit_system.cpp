@@ -25,8 +25,11 @@ void contactDiagonal(const Model& model, const double* x, double a, double b,
 
 }  // namespace
 
-ImplicitSystem::ImplicitSystem(const LinearSolverOptions& linearSolver, bool clampCompression)
+ImplicitSystem::ImplicitSystem(const LinearSolverOptions& linearSolver, bool clampCompression,
+                               bool directOperator)
     : clampCompression_(clampCompression),
+      direct_(directOperator && linearSolver.kind == LinearSolverKind::Cg &&
+              linearSolver.matrixFree && !preconditionerNeedsMatrix(linearSolver.preconditioner)),
       matrixFree_(linearSolver.kind == LinearSolverKind::Cg && linearSolver.matrixFree),
       solver_(linearSolver) {}
 
@@ -39,6 +42,7 @@ bool ImplicitSystem::bind(const Model& model) {
   jacobian_ = std::make_unique<JacobianAssembler>(model);
   if (matrixFree_) operator_ = std::make_unique<SystemOperator>(model.springs(), model.numPoints());
   A_ = jacobian_->pattern();
+  matricesStale_ = matrixStale_ = false;
   solver_.forgetPattern();
   laplacian_.reset();
   projective_.reset();
@@ -54,23 +58,91 @@ bool ImplicitSystem::bind(const Model& model) {
 void ImplicitSystem::assemble(const double* x, const double* v) {
   JELLO_ASSERT(bound(), "the implicit system is bound to a model before it assembles");
   const auto start = std::chrono::steady_clock::now();
-  jacobian_->assemble(x, {clampCompression_, false, v});
-  if (solver_.kind() == LinearSolverKind::Cg &&
-      solver_.preconditioner() == PreconditionerKind::Projective) {
-    x_ = Eigen::Map<const Eigen::VectorXd>(x, 3 * static_cast<Eigen::Index>(model_->numPoints()));
+  const Eigen::Index n3 = 3 * static_cast<Eigen::Index>(model_->numPoints());
+  JacobianOptions options{clampCompression_, false, v};
+  options.includeSprings = !direct_;  // their blocks come from x at factorize()
+  jacobian_->assemble(x, options);
+  clamps_ += jacobian_->lastClampCount();
+  if (direct_ || (solver_.kind() == LinearSolverKind::Cg &&
+                  solver_.preconditioner() == PreconditionerKind::Projective)) {
+    x_ = Eigen::Map<const Eigen::VectorXd>(x, n3);
+  }
+  if (direct_) {
+    assembledClamp_ = clampCompression_;
+    if (v) {
+      v_ = Eigen::Map<const Eigen::VectorXd>(v, n3);
+    } else {
+      v_.resize(0);
+    }
+    matricesStale_ = matrixStale_ = true;
   }
   assembleSeconds_ +=
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 void ImplicitSystem::formMatrix(double a, double b) {
-  jacobian_->combine(a, b, A_);
   a_ = a;
   b_ = b;
+  if (direct_) {
+    matrixStale_ = true;
+    return;
+  }
+  jacobian_->combine(a, b, A_);
+}
+
+void ImplicitSystem::formMatrices() {
+  if (!matricesStale_) return;
+  JacobianOptions options{assembledClamp_, false, v_.size() > 0 ? v_.data() : nullptr};
+  jacobian_->assemble(x_.data(), options);  // its clamps were counted by the fill
+  matricesStale_ = false;
+}
+
+const SparseMatrix& ImplicitSystem::K() {
+  formMatrices();
+  return jacobian_->K();
+}
+
+const SparseMatrix& ImplicitSystem::D() {
+  formMatrices();
+  return jacobian_->D();
+}
+
+const SparseMatrix& ImplicitSystem::A() {
+  if (direct_ && matrixStale_) {
+    formMatrices();
+    jacobian_->combine(a_, b_, A_);
+    matrixStale_ = false;
+  }
+  return A_;
+}
+
+double ImplicitSystem::dampingQuadratic(const Eigen::VectorXd& v) {
+  if (!direct_ || !matricesStale_) {
+    dv_.noalias() = D() * v;
+    return v.dot(dv_);
+  }
+  const std::vector<double>& diagD = jacobian_->diagonalD();
+  const Eigen::Index n = model_->numPoints();
+  double sum = operator_->springDampingQuadratic(x_.data(), v.data());
+  for (Eigen::Index p = 0; p < n; ++p) {
+    const double* B = diagD.data() + 9 * p;
+    const double u[3] = {v[p], v[n + p], v[2 * n + p]};
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) sum += u[r] * B[3 * r + c] * u[c];
+  }
+  return sum;
 }
 
 StepResult ImplicitSystem::factorize() {
-  if (operator_) operator_->gather(A_, jacobian_->diagonalSlots(), jacobian_->springSlots());
+  if (direct_) {
+    const auto start = std::chrono::steady_clock::now();
+    clamps_ += operator_->fill(x_.data(), model_->mass(), a_, b_, assembledClamp_,
+                               jacobian_->diagonalK().data(), jacobian_->diagonalD().data());
+    assembleSeconds_ +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  } else if (operator_) {
+    operator_->gather(A_, jacobian_->diagonalSlots(), jacobian_->springSlots());
+  }
   if (solver_.kind() == LinearSolverKind::Cg &&
       solver_.preconditioner() == PreconditionerKind::Projective) {
     contactDiagonal(*model_, x_.data(), a_, b_, contact_);
@@ -78,6 +150,7 @@ StepResult ImplicitSystem::factorize() {
       if (StepResult res = factorProjective(a_, b_, &contact_); !res.ok) return res;
     }
   }
+  if (direct_) return solver_.prepare(*operator_, A_.rows(), projective_.get());
   return solver_.factorize(A_, operator_.get(), projective_.get());
 }
 
@@ -181,7 +254,10 @@ StepResult ImplicitSystem::solveProjective(Eigen::VectorXd& v) const {
 }
 
 StepResult ImplicitSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) {
-  return solver_.solve(rhs, x);
+  StepResult result = solver_.solve(rhs, x);
+  // Not positive definite (possible only with the clamp off): LDLT of A, formed now.
+  if (!result.ok && direct_ && solver_.indefinite()) result = solver_.fallBackToLdlt(A(), rhs, x);
+  return result;
 }
 
 void ImplicitSystem::appendStatistics(std::vector<Statistic>& out) const {

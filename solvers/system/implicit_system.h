@@ -29,13 +29,20 @@ class SpringLaplacian;
 
 class ImplicitSystem {
  public:
-  ImplicitSystem(const LinearSolverOptions& linearSolver, bool clampCompression);
+  // directOperator: under matrix-free CG with a preconditioner that needs no sparse A (not
+  // preconditionerNeedsMatrix), A's blocks are filled straight from the springs at factorize()
+  // (SystemOperator::fill) and the sparse K, D and A are formed only when asked for (K(), D(),
+  // A(), an LDLT fallback): Newton needs only the product and dampingQuadratic.
+  ImplicitSystem(const LinearSolverOptions& linearSolver, bool clampCompression,
+                 bool directOperator = false);
   ~ImplicitSystem();
 
   // Binds to `model`; true when it is another model than the last (the pattern is rebuilt and
   // the solver analyses afresh: integrators must forget their history then).
   bool bind(const Model& model);
   bool bound() const { return jacobian_ != nullptr; }
+  // Whether A's blocks come straight from the springs (directOperator, where it applies).
+  bool fillsDirectly() const { return direct_; }
 
   // K and D at positions x and velocities v (3n each; v: friction's D, src/effects/obstacle.h,
   // left out when null): the last assembly until the next.
@@ -76,16 +83,20 @@ class ImplicitSystem {
   // (nothing when P holds them all).
   StepResult correctProjective(Eigen::VectorXd& v);
 
-  const SparseMatrix& K() const { return jacobian_->K(); }
-  const SparseMatrix& D() const { return jacobian_->D(); }
+  // The last assembly's K and D (formed on demand under directOperator).
+  const SparseMatrix& K();
+  const SparseMatrix& D();
+  // v^T D v with the last assembly's D (3n), without forming D under directOperator.
+  double dampingQuadratic(const Eigen::VectorXd& v);
   double frictionQuadratic(const double* v) const { return jacobian_->frictionQuadratic(v); }
   // Whether the next assembly projects compressed springs' Hessians (the clamp).
   void setClampCompression(bool clamp) { clampCompression_ = clamp; }
   bool clampsCompression() const { return clampCompression_; }
 
-  const SparseMatrix& A() const { return A_; }
+  // The last formMatrix's A (formed on demand under directOperator).
+  const SparseMatrix& A();
   const SpdSolver& solver() const { return solver_; }
-  long clampCount() const { return jacobian_ ? jacobian_->totalClampCount() : 0; }
+  long clampCount() const { return clamps_; }
 
   // compression_clamps, factorizations, ldlt_fallbacks, assemble/factor/solve times and (CG)
   // cg_iterations, appended to out.
@@ -97,7 +108,16 @@ class ImplicitSystem {
   bool keepsProjective(const Eigen::VectorXd& contact);
   // difference = contact - the C P holds; true when every entry is light (coarse_'s test).
   bool lightAgainstFactor(const Eigen::VectorXd& contact, Eigen::VectorXd& difference) const;
+  // directOperator: the sparse K and D of the last assembly at x_ and v_, with the clamp it
+  // had (formMatrices), and A for a_ and b_, formed only when asked for.
+  void formMatrices();
   bool clampCompression_;
+  bool direct_;
+  bool assembledClamp_ = true;
+  bool matricesStale_ = false, matrixStale_ = false;
+  Eigen::VectorXd v_;   // the last assembly's velocities (directOperator; empty: none)
+  Eigen::VectorXd dv_;  // dampingQuadratic's D v
+  long clamps_ = 0;
   long modelId_ = -1;
   const Model* model_ = nullptr;  // the one of the last bind: alive while a step runs
   bool matrixFree_;

@@ -82,6 +82,7 @@ void JacobianAssembler::assemble(const double* x, const JacobianOptions& options
   blocks.clampCompression = options.clampCompression;
   blocks.includeField = options.includeField;
   blocks.velocities = options.velocities;
+  blocks.includeSprings = options.includeSprings;
   const bool friction = options.velocities && model_.hasFriction();
   diagFriction_.assign(friction ? diagD_.size() : 0, 0.0);
   if (friction) blocks.diagFriction = diagFriction_.data();
@@ -89,6 +90,7 @@ void JacobianAssembler::assemble(const double* x, const JacobianOptions& options
   for (std::size_t i = 0; i < diagFriction_.size(); ++i) diagD_[i] += diagFriction_[i];
   lastClamps_ = blocks.clamps;
   totalClamps_ += blocks.clamps;
+  if (!options.includeSprings) return;
   for (std::size_t i = 0; i < diagSlots_.size(); ++i) {
     Kv[diagSlots_[i]] = diagK_[i];
     Dv[diagSlots_[i]] = diagD_[i];

@@ -25,6 +25,9 @@ struct JacobianOptions {
   // The velocities (3n) friction's D is evaluated at, the one term of D that depends on v, and
   // the smooth contact's damping term of K, c vn w'(q) (null: both are left out).
   const double* velocities = nullptr;
+  // Off: the other effects' diagonal blocks only (diagonalK(), diagonalD()); K() and D() keep
+  // the values of the last assembly with springs (SystemOperator::fill takes the springs').
+  bool includeSprings = true;
 };
 
 class JacobianAssembler {
@@ -51,6 +54,10 @@ class JacobianAssembler {
   // pattern's value array: what SystemOperator gathers.
   const std::vector<int>& springSlots() const { return springSlots_; }
   const std::vector<int>& diagonalSlots() const { return diagSlots_; }
+
+  // Every point's diagonal block of the last assembly (9 per point, row-major): of K and D.
+  const std::vector<double>& diagonalK() const { return diagK_; }
+  const std::vector<double>& diagonalD() const { return diagD_; }
 
   long lastClampCount() const { return lastClamps_; }  // springs clamped in the last assembly
   long totalClampCount() const { return totalClamps_; }

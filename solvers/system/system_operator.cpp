@@ -1,6 +1,7 @@
 #include "solvers/system/system_operator.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "src/base/assertions.h"
 #include "src/base/parallel.h"
@@ -42,6 +43,9 @@ SystemOperator::SystemOperator(const SpringForces& springs, int numPoints) : n_(
     group.first = g.first;
     group.count = static_cast<std::ptrdiff_t>(g.mask.size());
     group.delta = g.delta;
+    group.rest = g.rest;
+    group.stiffness = g.stiffness;
+    group.damping = g.damping;
     group.mask = g.mask;
     for (auto& c : group.c) c.assign(g.mask.size(), 0.0);
     maxDelta_ = std::max(maxDelta_, group.delta);
@@ -67,6 +71,89 @@ void SystemOperator::gather(const SparseMatrix& A, const std::vector<int>& diagS
     }
   }
   JELLO_ASSERT(slot == springSlots.data() + springSlots.size(), "every spring's slots used");
+}
+
+JELLO_VECTOR_CLONES long SystemOperator::fill(const double* x, double mass, double a, double b,
+                                              bool clamp, const double* diagK,
+                                              const double* diagD) {
+  const std::ptrdiff_t n = n_;
+  for (std::ptrdiff_t p = 0; p < n; ++p) {
+    for (int e = 0; e < 6; ++e) {
+      const std::ptrdiff_t i = 9 * p + kUpper[e];
+      diag_[e][p] = (e == 0 || e == 3 || e == 5 ? mass : 0.0) - a * diagD[i] - b * diagK[i];
+    }
+  }
+  long clamps = 0;
+  for (Group& g : groups_) {
+    const double* __restrict mask = g.mask.data();
+    const double *xp = x + g.first, *yp = x + n + g.first, *zp = x + 2 * n + g.first;
+    const double *xq = xp + g.delta, *yq = yp + g.delta, *zq = zp + g.delta;
+    double* __restrict cxx = g.c[0].data();
+    double* __restrict cxy = g.c[1].data();
+    double* __restrict cxz = g.c[2].data();
+    double* __restrict cyy = g.c[3].data();
+    double* __restrict cyz = g.c[4].data();
+    double* __restrict czz = g.c[5].data();
+    const double kb = b * g.stiffness, ca = a * g.damping, rest = g.rest;
+    long groupClamps = 0;
+    // The block is -(a c + b k (1 - alpha)) P - b k alpha I: unit stride, no branch (a missing
+    // spring's mask is 0, its block selected to 0), so the loop vectorizes.
+#pragma omp simd reduction(+ : groupClamps)
+    for (std::ptrdiff_t s = 0; s < g.count; ++s) {
+      const double dx = xq[s] - xp[s], dy = yq[s] - yp[s], dz = zq[s] - zp[s];
+      const double length = std::sqrt(dx * dx + dy * dy + dz * dz);
+      const bool spring = mask[s] != 0.0;
+      const double inv = spring ? 1.0 / length : 0.0;
+      double alpha = 1.0 - rest * inv;
+      const bool clamped = clamp && spring && alpha < 0.0;
+      groupClamps += clamped ? 1 : 0;
+      alpha = clamped ? 0.0 : alpha;
+      const double ux = dx * inv, uy = dy * inv, uz = dz * inv;
+      const double beta = spring ? -(ca + kb * (1.0 - alpha)) : 0.0;
+      const double iso = spring ? -kb * alpha : 0.0;
+      cxx[s] = beta * ux * ux + iso;
+      cxy[s] = beta * ux * uy;
+      cxz[s] = beta * ux * uz;
+      cyy[s] = beta * uy * uy + iso;
+      cyz[s] = beta * uy * uz;
+      czz[s] = beta * uz * uz + iso;
+    }
+    clamps += groupClamps;
+    // Each spring's block, negated, on both ends' diagonal blocks (two loops: the ends of one
+    // group never alias within a loop).
+    for (std::ptrdiff_t end : {g.first, g.first + g.delta}) {
+      for (int e = 0; e < 6; ++e) {
+        double* __restrict d = diag_[e].data() + end;
+        const double* __restrict c = g.c[e].data();
+#pragma omp simd
+        for (std::ptrdiff_t s = 0; s < g.count; ++s) d[s] -= c[s];
+      }
+    }
+  }
+  return clamps;
+}
+
+JELLO_VECTOR_CLONES double SystemOperator::springDampingQuadratic(const double* x,
+                                                                  const double* v) const {
+  const std::ptrdiff_t n = n_;
+  double sum = 0.0;
+  for (const Group& g : groups_) {
+    const double* __restrict mask = g.mask.data();
+    const double *xp = x + g.first, *yp = x + n + g.first, *zp = x + 2 * n + g.first;
+    const double *xq = xp + g.delta, *yq = yp + g.delta, *zq = zp + g.delta;
+    const double *vxp = v + g.first, *vyp = v + n + g.first, *vzp = v + 2 * n + g.first;
+    const double *vxq = vxp + g.delta, *vyq = vyp + g.delta, *vzq = vzp + g.delta;
+    double groupSum = 0.0;
+#pragma omp simd reduction(+ : groupSum)
+    for (std::ptrdiff_t s = 0; s < g.count; ++s) {
+      const double dx = xq[s] - xp[s], dy = yq[s] - yp[s], dz = zq[s] - zp[s];
+      const double dv = dx * (vxq[s] - vxp[s]) + dy * (vyq[s] - vyp[s]) + dz * (vzq[s] - vzp[s]);
+      const double length2 = dx * dx + dy * dy + dz * dz;
+      groupSum += mask[s] != 0.0 ? dv * dv / length2 : 0.0;
+    }
+    sum -= g.damping * groupSum;
+  }
+  return sum;
 }
 
 void SystemOperator::apply(const double* p, double* y) const {

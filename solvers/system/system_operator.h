@@ -29,6 +29,18 @@ class SystemOperator final : public LinearOperator {
   void gather(const SparseMatrix& A, const std::vector<int>& diagSlots,
               const std::vector<int>& springSlots);
 
+  // A = mass I - a D - b K straight from the springs at positions x (3n), without the sparse
+  // matrices: each spring's (a, b) block is -a c P - b k (P + alpha (I - P)) (P = u u^T,
+  // alpha = 1 - rest/length, 0 where `clamp` projects a compressed spring), each point's diagonal
+  // block mass I - a diagD - b diagK (9 per point, row-major: the other effects' terms,
+  // JacobianAssembler::assemble without the springs) minus its springs' blocks. The same values
+  // gather() takes from the assembled A, in one vectorized pass; returns the springs clamped.
+  long fill(const double* x, double mass, double a, double b, bool clamp, const double* diagK,
+            const double* diagD);
+
+  // The springs' part of v^T D v at positions x (both 3n): -sum c (u . (v_b - v_a))^2.
+  double springDampingQuadratic(const double* x, const double* v) const;
+
   // y = A p, both 3n component-major; y is overwritten, and must not alias p. Split over
   // threads from kParallelMinPoints points (src/base/parallel.h), as the spring forces are
   // (round-off apart from the serial sum); BM_Threads/product measures one thread against two.
@@ -44,6 +56,7 @@ class SystemOperator final : public LinearOperator {
  private:
   struct Group {
     std::ptrdiff_t first = 0, count = 0, delta = 0;
+    double rest = 0.0, stiffness = 0.0, damping = 0.0;
     std::vector<double> mask;              // 1 where the slot is a spring
     std::array<std::vector<double>, 6> c;  // the spring's block of A, upper triangle
   };

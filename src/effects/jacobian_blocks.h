@@ -22,6 +22,9 @@ struct JacobianBlocks {
   bool clampCompression = true;
   // The field's gradient (not symmetric: not for Cholesky).
   bool includeField = false;
+  // The springs' terms (off: the other effects' diagonal blocks only, for a caller that takes
+  // the springs' blocks straight from the positions, solvers/system/system_operator.h).
+  bool includeSprings = true;
   // The velocities (3n) friction's D and the smooth law's damping term of K are evaluated at;
   // none: both are left out.
   const double* velocities = nullptr;
