@@ -9,8 +9,8 @@ and the plane, wall time per step after the first) on one core of the native bui
 single-threaded BLAS and CHOLMOD, and writes Google Benchmark's JSON to
 experiments/results/contact_speed.json; with --only, those of one integrator, replacing its
 entries in that file and keeping the others' (implicit at 16^3 takes ten minutes); with --n, those
-of one cube size (implicit_fast, the seeded Newton on the exact Jacobian, is measured at 8^3:
-at 16^3 jello.w's impacts cost it about 50 Newton iterations a step). Without it,
+of one cube size (implicit_fast, ImplicitOptions::fast(), is measured at 8^3:
+at 16^3 jello.w's impacts cost it step halvings and many Newton iterations). Without it,
 prints the README's table (block
 contact-speed, which scripts/results-tables.py writes from that file alone).
 """
@@ -27,7 +27,7 @@ BINARY = os.path.join(ROOT, "build", "native", "bin", "benchmarks")
 
 
 # The benchmarks' integrator names and how the table shows them.
-LABELS = {"implicit_fast": "`implicit`, fast (seeded, exact Jacobian)"}
+LABELS = {"implicit_fast": "`implicit`, fast (ImplicitOptions::fast())"}
 
 
 def run(only=None, n=None):

@@ -55,6 +55,24 @@ struct ImplicitOptions {
   LinearSolverOptions linearSolverOptions() const {
     return {linearSolver, cgTolerance, preconditioner, matrixFree};
   }
+
+  // The converged Newton methods' fastest configuration measured (solvers/README.md, "The fast
+  // configuration"): up to 10 Chebyshev-accelerated projective seeds, then plain Newton on the
+  // exact Jacobian (clamped on demand), each update solved inexactly by CG to 1e-2 of its
+  // right-hand side, preconditioned by the projective matrix. Newton still stops at
+  // newtonTolerance on the residual: the converged step is the same.
+  static ImplicitOptions fast() {
+    ImplicitOptions o;
+    o.linearSolver = LinearSolverKind::Cg;
+    o.preconditioner = PreconditionerKind::Projective;
+    o.cgTolerance = 1e-2;
+    o.seedIterations = 10;
+    o.seedTolerance = o.newtonTolerance;
+    o.seedChebyshevRho = 0.9;
+    o.clampOnDemand = true;
+    o.reuseFactor = false;
+    return o;
+  }
 };
 
 enum class CvodeMethod {

@@ -151,6 +151,20 @@ TEST_P(HardCaseTest, Bdf2SeededAndPreconditionedStaysStable) {
   expectStableForTwoSeconds(GetParam(), IntegratorKind::Bdf2, seededAndPreconditioned());
 }
 
+// The fastest configuration measured (ImplicitOptions::fast(): 10 seeds, plain Newton on the
+// exact Jacobian, each update solved by CG to 1e-2 of its right-hand side).
+TEST_P(HardCaseTest, ImplicitFastStaysStable) {
+  SolverOptions o;
+  o.implicit = ImplicitOptions::fast();
+  expectStableForTwoSeconds(GetParam(), IntegratorKind::Implicit, o);
+}
+
+TEST_P(HardCaseTest, Bdf2FastStaysStable) {
+  SolverOptions o;
+  o.implicit = ImplicitOptions::fast();
+  expectStableForTwoSeconds(GetParam(), IntegratorKind::Bdf2, o);
+}
+
 // The default solves by CG; the direct solve stays covered.
 TEST_P(HardCaseTest, ImplicitCholmodStaysStable) {
   SolverOptions o;

@@ -53,23 +53,16 @@ World jelloAt(int n) {
   return resampleCube(readWorld(std::filesystem::path(JELLO_WORLDS_DIR) / "jello.w"), n);
 }
 
-// The converged Newton methods' fastest configuration measured (README, Implicit solvers): CG
-// preconditioned by the projective matrix, after up to 60 projective seed iterations with
-// Chebyshev acceleration (rho 0.9) down to Newton's own tolerance. Measured at 8^3 on the
-// spinning cube: 6.1 ms a step with 30 plain seeds to 1e-4 (then 3 Newton iterations), 2.5 ms
-// with these (0.06 Newton iterations a step); rho 0.85 3.0 ms, 0.95 4.3 ms, 40 seeds 3.7 ms.
-// Then Newton on the exact Jacobian, clamped on demand, and refactored (CG: its operator
-// gathered afresh) at every iteration: on jello.w with smooth contact (100 steps) 1.6 Newton
-// iterations a step instead of 3.5 with the clamp and the kept operator.
+// The converged Newton methods' fastest configuration measured (ImplicitOptions::fast()):
+// 10 Chebyshev seeds, then plain Newton on the exact Jacobian, clamped on demand, with A filled
+// straight from the springs at every iteration and each update solved by CG to 1e-2,
+// preconditioned by the projective matrix. Measured with jello-sim on jello.w, 100 steps,
+// smooth contact (one core): 2.1 ms a step; 0 seeds 2.5 ms; 20 seeds and CG to 1e-3 2.5 ms; the
+// earlier configuration (60 seeds to 1e-8, CG to 1e-6) 4.4 ms; spinning cube 1.0-1.3 ms for all
+// but the 60 seeds (2.1 ms).
 SolverOptions fastNewton() {
   SolverOptions o;
-  o.implicit.linearSolver = LinearSolverKind::Cg;
-  o.implicit.preconditioner = PreconditionerKind::Projective;
-  o.implicit.seedIterations = 60;
-  o.implicit.seedTolerance = o.implicit.newtonTolerance;
-  o.implicit.seedChebyshevRho = 0.9;
-  o.implicit.clampOnDemand = true;
-  o.implicit.reuseFactor = false;
+  o.implicit = ImplicitOptions::fast();
   return o;
 }
 
