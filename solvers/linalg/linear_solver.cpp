@@ -432,7 +432,7 @@ StepResult SpdSolver::fallBackToLdlt(const SparseMatrix& A, const Eigen::VectorX
   return result;
 }
 
-StepResult SpdSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+StepResult SpdSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x, bool ldltFallback) {
   const auto start = Clock::now();
   Impl& s = *impl_;
   StepResult result = StepResult::success();
@@ -441,7 +441,7 @@ StepResult SpdSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
     result = conjugateGradients(b, x);
     // Not positive definite (possible only with the clamp off): LDLT until the next factorize,
     // as cholmod falls back.
-    if (!result.ok && s.indefinite && s.A) {
+    if (!result.ok && s.indefinite && s.A && ldltFallback) {
       ++stats_.fallbacks;
       result = s.factorLdlt(*s.A, stats_);
       s.useLdlt = result.ok;

@@ -126,8 +126,9 @@ class SpdSolver {
   StepResult fallBackToLdlt(const SparseMatrix& A, const Eigen::VectorXd& b, Eigen::VectorXd& x);
   // The next factorize analyzes its matrix's pattern afresh (a new model).
   void forgetPattern();
-  // x: on entry the initial guess (cg), on return the solution.
-  StepResult solve(const Eigen::VectorXd& b, Eigen::VectorXd& x);
+  // x: on entry the initial guess (cg), on return the solution. ldltFallback false: CG meeting
+  // a direction of non-positive curvature fails the solve (indefinite()) without LDLT.
+  StepResult solve(const Eigen::VectorXd& b, Eigen::VectorXd& x, bool ldltFallback = true);
 
   LinearSolverKind kind() const { return kind_; }
   PreconditionerKind preconditioner() const { return preconditioner_; }

@@ -112,7 +112,10 @@ StepResult NewtonIntegrator::prepareNewtonMatrix(double h, bool refactor) {
 StepResult NewtonIntegrator::solveNewton(double h, bool refactor) {
   const auto attempt = [&](bool fresh) {
     StepResult res = prepareNewtonMatrix(h, fresh);
-    if (res.ok) res = system_.solve(rhs_, delta_);
+    // Unclamped on demand, CG's negative curvature goes straight to the clamp below, without
+    // an LDLT of the indefinite matrix first (seconds at 16^3, and thrown away).
+    const bool unclamped = options_.clampOnDemand && !system_.clampsCompression();
+    if (res.ok) res = system_.solve(rhs_, delta_, !unclamped);
     if (res.ok && !delta_.allFinite())
       res = StepResult::failure("Newton produced a non-finite update");
     return res;

@@ -253,10 +253,13 @@ StepResult ImplicitSystem::solveProjective(Eigen::VectorXd& v) const {
   return projective_->solve(v.data(), 3);
 }
 
-StepResult ImplicitSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x) {
-  StepResult result = solver_.solve(rhs, x);
+StepResult ImplicitSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x,
+                                 bool ldltFallback) {
+  StepResult result = solver_.solve(rhs, x, ldltFallback);
   // Not positive definite (possible only with the clamp off): LDLT of A, formed now.
-  if (!result.ok && direct_ && solver_.indefinite()) result = solver_.fallBackToLdlt(A(), rhs, x);
+  if (!result.ok && direct_ && ldltFallback && solver_.indefinite()) {
+    result = solver_.fallBackToLdlt(A(), rhs, x);
+  }
   return result;
 }
 

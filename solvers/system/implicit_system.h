@@ -54,8 +54,10 @@ class ImplicitSystem {
   StepResult factorize();
   // formMatrix(a, b), then factorize().
   StepResult factorize(double a, double b);
-  // x: on entry CG's initial guess, on return the solution of A x = rhs.
-  StepResult solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x);
+  // x: on entry CG's initial guess, on return the solution of A x = rhs. ldltFallback false: an
+  // indefinite A fails the solve (solver().indefinite()) instead of falling back to LDLT, for a
+  // caller that clamps then (Newton on demand: an LDLT of A at 16^3 costs seconds).
+  StepResult solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& x, bool ldltFallback = true);
 
   // The projective matrix P(a, b) = M + L(a c + b k) + C on each coordinate of the bound model
   // (solvers/system/spring_laplacian.h), factored when a, b or C changed: CG's projective
