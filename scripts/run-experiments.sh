@@ -14,10 +14,73 @@
 # budget, two points at a time) into experiments/results/atlas_free/, and draws its charts
 # (about 8 and 30 minutes on a 2-core VM).
 # `scripts/run-experiments.sh charts` runs nothing: it redraws every chart from the committed CSV.
+# `--ranks K` (with any of the above but charts) runs each program as one MPI job of K ranks
+# (mpirun; on a cluster, inside the allocation): the grid points dealt out over the ranks, one
+# point at a time per rank, rank 0 writing the CSV; with `atlas`, the whole atlas (N = 16 and
+# 32, every k, the stored references) is that one job. JELLO_BIN=DIR runs the programs in DIR
+# instead of building the native ones (the tests: build/release/bin).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+usage="usage: scripts/run-experiments.sh [quick | atlas | atlas-free | charts] [--ranks K]"
+mode=
+ranks=
+while [ $# -gt 0 ]; do
+  case "$1" in
+    quick | atlas | atlas-free | charts)
+      if [ -n "$mode" ]; then
+        echo "run-experiments: '$1' after '$mode': one mode at a time ($usage)" >&2
+        exit 2
+      fi
+      mode=$1
+      shift
+      ;;
+    --ranks)
+      if [ $# -lt 2 ]; then
+        echo "run-experiments: --ranks needs the number of MPI ranks ($usage)" >&2
+        exit 2
+      fi
+      ranks=$2
+      shift 2
+      ;;
+    --ranks=*)
+      ranks=${1#--ranks=}
+      shift
+      ;;
+    -h | --help)
+      echo "$usage"
+      sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'
+      exit 0
+      ;;
+    *)
+      echo "run-experiments: unknown argument '$1' ($usage)" >&2
+      exit 2
+      ;;
+  esac
+done
+if [ -n "$ranks" ] && ! [[ "$ranks" =~ ^[1-9][0-9]{0,3}$ ]]; then
+  echo "run-experiments: --ranks '$ranks' is not a number of ranks from 1 to 9999" >&2
+  exit 2
+fi
+if [ -n "$ranks" ] && [ "$mode" = charts ]; then
+  echo "run-experiments: charts runs nothing: --ranks does not apply" >&2
+  exit 2
+fi
+set -- ${mode:+"$mode"}
 scripts/install-deps.sh
-bin=build/native/bin  # -march=native: the committed results and figures (README)
+bin=${JELLO_BIN:-build/native/bin}  # -march=native: the committed results and figures (README)
+# The launcher of every program (none without --ranks). PMIx's shared-memory store cannot start
+# on some machines (experiments/README.md): its hash store works everywhere. As root, Open MPI
+# wants to be told.
+launch=()
+if [ -n "$ranks" ]; then
+  if ! command -v mpirun >/dev/null; then
+    echo "run-experiments: --ranks needs mpirun (Debian: openmpi-bin)" >&2
+    exit 1
+  fi
+  export PMIX_MCA_gds=${PMIX_MCA_gds:-hash}
+  launch=(mpirun --oversubscribe -np "$ranks")
+  if [ "$(id -u)" = 0 ]; then launch+=(--allow-run-as-root); fi
+fi
 out=experiments/results
 args=()
 stability_scenes='free wall'
@@ -46,7 +109,7 @@ if [ "${1:-}" = charts ]; then
   echo "run-experiments: charts redrawn in $out/"
   exit 0
 fi
-scripts/build.sh native >/dev/null
+if [ -z "${JELLO_BIN:-}" ]; then scripts/build.sh native >/dev/null; fi
 # Committed results come from a clean tree: each sidecar records its commit, which must be the
 # code that ran. JELLO_ALLOW_DIRTY=1 runs anyway (the sidecars then say "tree_modified": true).
 if [ "$out" = experiments/results ] && [ -z "${JELLO_ALLOW_DIRTY:-}" ] &&
@@ -61,6 +124,16 @@ if [ "${1:-}" = atlas ]; then
   # A run of 60 s is allowed (20 at N = 8): at N = 16 and 32 a converged implicit second costs
   # tens of seconds, and a 20 s budget would hide where it is cheapest.
   common=(--no-grid --atlas-budget 60 --jobs 1 --out-dir "$out")
+  # The two layouts of the same cells (one job's atlas.csv, or the split run's four files):
+  # each run removes the other's, which would repeat its cells.
+  if [ -n "$ranks" ]; then
+    "${launch[@]}" "$bin/jello-scaling" "${common[@]}" --atlas-n 16,32 \
+      --atlas-references "$out/atlas_references" --name atlas --quiet
+    rm -f "$out"/atlas16{.json,_atlas.csv} "$out"/atlas32{,stiff,stiffest}{.json,_atlas.csv}
+    draw_atlas
+    echo "run-experiments: the atlas at N = 16 and 32 in $out/ ($ranks ranks)"
+    exit 0
+  fi
   taskset -c 0 "$bin/jello-scaling" "${common[@]}" --atlas-n 16 --name atlas16 &
   first=$!
   taskset -c 1 "$bin/jello-scaling" "${common[@]}" --atlas-n 32 \
@@ -72,6 +145,7 @@ if [ "${1:-}" = atlas ]; then
   JELLO_THREADS=1 "$bin/jello-scaling" "${common[@]}" --atlas-n 32 --atlas-k 1e8 \
     --atlas-reference-threads 2 --atlas-references "$out/atlas_references" \
     --name atlas32stiffest --quiet
+  rm -f "$out"/atlas{.json,_atlas.csv}
   draw_atlas
   echo "run-experiments: the atlas at N = 16 and 32 in $out/"
   exit 0
@@ -80,22 +154,36 @@ if [ "${1:-}" = atlas-free ]; then
   export OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1
   free="$out/atlas_free"
   mkdir -p "$free"
-  taskset -c 1 "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 8 --jobs 1 \
-    --out-dir "$free"
-  "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 16 --atlas-k 1e5,1e6,1e7 \
-    --atlas-budget 60 --jobs 2 --name atlas16 --out-dir "$free"
+  if [ -n "$ranks" ]; then
+    "${launch[@]}" "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 8 --jobs 1 \
+      --quiet --out-dir "$free"
+    "${launch[@]}" "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 16 \
+      --atlas-k 1e5,1e6,1e7 --atlas-budget 60 --jobs 1 --name atlas16 --quiet --out-dir "$free"
+  else
+    taskset -c 1 "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 8 --jobs 1 \
+      --out-dir "$free"
+    "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 16 --atlas-k 1e5,1e6,1e7 \
+      --atlas-budget 60 --jobs 2 --name atlas16 --out-dir "$free"
+  fi
   draw_free_atlas
   echo "run-experiments: the free scene's atlas in $free/"
   exit 0
 fi
-"$bin/jello-stability" "${args[@]}" --out-dir "$out"
-"$bin/jello-work-precision" "${args[@]}" --out-dir "$out"
+# Under --ranks, one point at a time per rank (--jobs 1), quietly (one progress line per rank
+# would interleave).
+if [ -n "$ranks" ]; then args+=(--jobs 1 --quiet); fi
+"${launch[@]}" "$bin/jello-stability" "${args[@]}" --out-dir "$out"
+"${launch[@]}" "$bin/jello-work-precision" "${args[@]}" --out-dir "$out"
 # One point at a time: a neighbour's memory traffic would bend the timings. The atlas at N = 8
 # only: N = 16 and 32 are `scripts/run-experiments.sh atlas` (or `mpirun -np K jello-scaling
 # --atlas-n 16,32` on a cluster).
 atlas_n=(--atlas-n 8)
 [ "${1:-}" = quick ] && atlas_n=()
-"$bin/jello-scaling" "${args[@]}" "${atlas_n[@]}" --jobs 1 --out-dir "$out"
+if [ -n "$ranks" ]; then
+  "${launch[@]}" "$bin/jello-scaling" "${args[@]}" "${atlas_n[@]}" --out-dir "$out"
+else
+  "$bin/jello-scaling" "${args[@]}" "${atlas_n[@]}" --jobs 1 --out-dir "$out"
+fi
 gnuplot -e "dir='$out'; scenes='$stability_scenes'" experiments/plots/stability.gp
 gnuplot -e "dir='$out'; scenes='$precision_scenes'" experiments/plots/work_precision.gp
 draw_atlas
