@@ -13,6 +13,9 @@
 # without gravity: no contact) at N = 8 (one core), then at N = 16 for k = 1e5, 1e6, 1e7 (a 60 s
 # budget, two points at a time) into experiments/results/atlas_free/, and draws its charts
 # (about 8 and 30 minutes on a 2-core VM).
+# `scripts/run-experiments.sh atlas-contact` runs the falling scene's atlas at N = 8 with the floor
+# as stiff as the springs and 20 times stiffer (--atlas-contact k, 20k), one point at a time,
+# into experiments/results/atlas_contact_k/ and atlas_contact_20k/ (about 20 minutes each).
 # `scripts/run-experiments.sh charts` runs nothing: it redraws every chart from the committed CSV.
 # `--ranks K` (with any of the above but charts) runs each program as one MPI job of K ranks
 # (mpirun; on a cluster, inside the allocation): the grid points dealt out over the ranks, one
@@ -21,12 +24,12 @@
 # instead of building the native ones (the tests: build/release/bin).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-usage="usage: scripts/run-experiments.sh [quick | atlas | atlas-free | charts] [--ranks K]"
+usage="usage: scripts/run-experiments.sh [quick | atlas | atlas-free | atlas-contact | charts] [--ranks K]"
 mode=
 ranks=
 while [ $# -gt 0 ]; do
   case "$1" in
-    quick | atlas | atlas-free | charts)
+    quick | atlas | atlas-free | atlas-contact | charts)
       if [ -n "$mode" ]; then
         echo "run-experiments: '$1' after '$mode': one mode at a time ($usage)" >&2
         exit 2
@@ -167,6 +170,22 @@ if [ "${1:-}" = atlas-free ]; then
   fi
   draw_free_atlas
   echo "run-experiments: the free scene's atlas in $free/"
+  exit 0
+fi
+if [ "${1:-}" = atlas-contact ]; then
+  export OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1
+  for contact in k 20k; do
+    dir="$out/atlas_contact_$contact"
+    mkdir -p "$dir"
+    if [ -n "$ranks" ]; then
+      "${launch[@]}" "$bin/jello-scaling" --no-grid --atlas-n 8 --atlas-contact "$contact" \
+        --jobs 1 --quiet --out-dir "$dir"
+    else
+      taskset -c 1 "$bin/jello-scaling" --no-grid --atlas-n 8 --atlas-contact "$contact" \
+        --jobs 1 --out-dir "$dir"
+    fi
+  done
+  echo "run-experiments: the falling scene's atlas with stiffer floors in $out/atlas_contact_*/"
   exit 0
 fi
 # Under --ranks, one point at a time per rank (--jobs 1), quietly (one progress line per rank

@@ -38,7 +38,43 @@ std::string describe(AtlasScene scene) {
                "touching nothing within the window, c = 0.25 N*s/m";
 }
 
-World atlasScene(double k, int n, AtlasScene scene) {
+std::optional<AtlasContact> parseAtlasContact(const std::string& name) {
+  if (name == "soft") return AtlasContact::Soft;
+  if (name == "k") return AtlasContact::AsStiff;
+  if (name == "20k") return AtlasContact::Stiffer;
+  return std::nullopt;
+}
+
+std::string contactName(AtlasContact contact) {
+  switch (contact) {
+    case AtlasContact::Soft:
+      return "soft";
+    case AtlasContact::AsStiff:
+      return "k";
+    case AtlasContact::Stiffer:
+      return "20k";
+  }
+  return "soft";
+}
+
+double contactStiffness(AtlasContact contact, double k) {
+  switch (contact) {
+    case AtlasContact::Soft:
+      return 400.0;  // the course's kCollision
+    case AtlasContact::AsStiff:
+      return k;
+    case AtlasContact::Stiffer:
+      return 20.0 * k;
+  }
+  return 400.0;
+}
+
+std::string referenceSceneName(AtlasScene scene, AtlasContact contact) {
+  return contact == AtlasContact::Soft ? sceneName(scene)
+                                       : sceneName(scene) + "-contact-" + contactName(contact);
+}
+
+World atlasScene(double k, int n, AtlasScene scene, AtlasContact contact) {
   SceneSpec spec = stiffCube(k);  // c = 0.25 N*s/m, no plane
   spec.cubeResolution = n;
   spec.pose = PosePreset::Rest;
@@ -51,6 +87,7 @@ World atlasScene(double k, int n, AtlasScene scene) {
   } else {
     spec.fieldResolution = 0;
   }
+  spec.kCollision = contactStiffness(contact, k);
   World w = buildWorld(spec);
   // Centred in the box: falling, 1.5 m above the floor (z = -2), reached after about 0.55 s;
   // free, 1 s of drift moves it 0.5 m, its corners (0.87 m from the centre) stay 0.6 m from
@@ -202,16 +239,31 @@ std::vector<Fit> referenceFits(const World& w, const TrajectoryKey& key, const A
 
 }  // namespace
 
-AtlasReference atlasReference(const World& w, double k, AtlasScene scene, const AtlasSetup& setup) {
+double atlasMaxFrequency(const World& w, AtlasScene scene) {
+  const Model model(w);
+  State s = initialState(w);
+  const double start = maxAngularFrequency(model, s);
+  if (scene == AtlasScene::Free) return start;
+  // At rest shape, its lowest points 1 mm below the floor (z = -2).
+  const int n = s.numPoints();
+  const double lowest = s.x.tail(n).minCoeff();
+  s.x.tail(n).array() += -2.001 - lowest;
+  s.v.setZero();
+  return std::max(start, maxAngularFrequency(model, s));
+}
+
+AtlasReference atlasReference(const World& w, double k, AtlasScene scene, const AtlasSetup& setup,
+                              AtlasContact contact) {
   const ThreadsFor threads(setup.referenceThreads);
   AtlasReference ref;
-  ref.wMax = maxAngularFrequency(Model(w), initialState(w));
+  ref.wMax = atlasMaxFrequency(w, scene);
   ref.dt =
       setup.interval /
       std::pow(2.0,
                std::max(0.0, std::ceil(std::log2(setup.interval * ref.wMax / setup.referenceHw))));
   const VisibleMotion visible(w.cubeResolution);
-  TrajectoryKey key{sceneName(scene), k, w.cubeResolution, ref.dt, setup.interval, setup.time};
+  TrajectoryKey key{
+      referenceSceneName(scene, contact), k, w.cubeResolution, ref.dt, setup.interval, setup.time};
   ref.samples = referenceFits(w, key, setup, visible);
   key.dt = 2.0 * ref.dt;
   const std::vector<Fit> check = referenceFits(w, key, setup, visible);

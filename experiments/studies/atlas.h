@@ -44,8 +44,25 @@ std::optional<AtlasScene> parseAtlasScene(const std::string& name);
 std::string sceneName(AtlasScene scene);  // as parseAtlasScene reads it
 std::string describe(AtlasScene scene);
 
+// The floor's penalty contact in the falling scene (issue 39, contact stiffness as an axis): the
+// course's kCollision = 400 N/m (`soft`, the default), as stiff as the lattice's springs (`k`),
+// or 20 k (`20k`, as the stability map's wall scene).
+enum class AtlasContact { Soft, AsStiff, Stiffer };
+std::optional<AtlasContact> parseAtlasContact(const std::string& name);
+std::string contactName(AtlasContact contact);            // as parseAtlasContact reads it
+double contactStiffness(AtlasContact contact, double k);  // N/m
+// The name stored references are kept under: the scene's ("falling", "free"), with the
+// contact's after it unless soft ("falling-contact-20k"), so the soft atlas's stay valid.
+std::string referenceSceneName(AtlasScene scene, AtlasContact contact);
+
 // The scene at stiffness k (c = 0.25 N*s/m), N^3 points of 1/512 kg (w_max does not depend on N).
-World atlasScene(double k, int n, AtlasScene scene = AtlasScene::Falling);
+World atlasScene(double k, int n, AtlasScene scene = AtlasScene::Falling,
+                 AtlasContact contact = AtlasContact::Soft);
+
+// w_max of the scene, contact included: the larger of the lattice's at the start and the cube's
+// resting on the floor (its bottom face 1 mm inside it, every bottom point on a contact spring:
+// the stiffest the contact makes it). The free scene touches nothing: the start's alone.
+double atlasMaxFrequency(const World& w, AtlasScene scene);
 
 // Visible motion: the least-squares affine map x = A r + t of the rest lattice (r centred) onto
 // a state, and the largest distance between two such maps at the cube's corners.
@@ -67,8 +84,10 @@ struct AtlasReference {
   double dt = 0.0;                                   // s
   double check = 0.0;  // m, the largest corner distance from RK4 at twice the reference's step
 };
-// The reference of `scene` at stiffness k (`w`, atlasScene's), and its check.
-AtlasReference atlasReference(const World& w, double k, AtlasScene scene, const AtlasSetup& setup);
+// The reference of `scene` at stiffness k (`w`, atlasScene's with `contact`), and its check:
+// RK4 at h w_max <= setup.referenceHw, w_max atlasMaxFrequency's.
+AtlasReference atlasReference(const World& w, double k, AtlasScene scene, const AtlasSetup& setup,
+                              AtlasContact contact = AtlasContact::Soft);
 
 // The integrators an atlas point compares (quick: symplectic, rk4, implicit, midpoint,
 // projective).

@@ -6,7 +6,8 @@
 // Also the crossover atlas (atlas.h): over k and N, each integrator's cost at the largest step
 // that keeps the visible motion within a tolerance.
 //   jello-scaling [--quick] [--n LIST] [--budget S] [--atlas-k LIST] [--atlas-n LIST]
-//                 [--atlas-scene falling|free] [--atlas-references DIR]
+//                 [--atlas-scene falling|free] [--atlas-contact soft|k|20k]
+//                 [--atlas-references DIR]
 //                 [--out-dir DIR] [--jobs N]
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -44,6 +45,7 @@ struct Options {
   std::vector<int> atlasN{8, 16, 32};
   AtlasSetup atlas;
   std::string atlasScene = "falling";
+  std::string atlasContact = "soft";
   std::string referenceDir;
 };
 
@@ -97,6 +99,11 @@ void addAtlasOptions(CLI::App& app, Options& opt) {
                  "The atlas's scene: falling (thrown, spinning, onto the floor under gravity) or "
                  "free (the same throw and spin without gravity: no contact)")
       ->check(CLI::IsMember({"falling", "free"}))
+      ->capture_default_str();
+  app.add_option("--atlas-contact", opt.atlasContact,
+                 "The falling scene's floor: penalty contact of the course's 400 N/m (soft), as "
+                 "stiff as the springs (k) or 20 times stiffer (20k)")
+      ->check(CLI::IsMember({"soft", "k", "20k"}))
       ->capture_default_str();
   app.add_option("--atlas-budget", opt.atlas.runBudget,
                  "Wall seconds of one atlas run beyond which smaller steps are not tried")
@@ -206,7 +213,8 @@ void runTask(const Task& t, const Options& opt, CsvTable& table) {
                    : std::nan("")});
 }
 
-nlohmann::json parameters(const Options& opt, const Study& study, const AtlasScene& scene) {
+nlohmann::json parameters(const Options& opt, const Study& study, const AtlasScene& scene,
+                          AtlasContact contact) {
   std::vector<std::string> atlasNames;
   for (IntegratorKind kind : atlasIntegrators(study.quick)) {
     atlasNames.emplace_back(integratorName(kind));
@@ -225,6 +233,13 @@ nlohmann::json parameters(const Options& opt, const Study& study, const AtlasSce
             {"n", opt.atlasN},
             {"scene_name", opt.atlasScene},
             {"scene", describe(scene)},
+            {"contact", contactName(contact)},
+            {"k_collision", contact == AtlasContact::Soft      ? "400 N/m"
+                            : contact == AtlasContact::AsStiff ? "k"
+                                                               : "20 k"},
+            {"w_max",
+             "the larger of the start's and the cube's resting on the floor, contact "
+             "springs included"},
             {"time_s", atlas.time},
             {"sample_interval_s", atlas.interval},
             {"tolerance_m", atlas.tolerance},
@@ -256,8 +271,11 @@ int main(int argc, char** argv) {
       "rk4, implicit, midpoint and projective, 4 steps tried each",
       "Points run in parallel (1 gives timings free of a neighbour's memory traffic)");
   const auto code = study.start(argc, argv, [&]() -> std::string {
-    return opt.atlas.referenceThreads > 0 && study.jobs > 1
-               ? "--atlas-reference-threads needs --jobs 1 (with several jobs each holds a CPU)"
+    if (opt.atlas.referenceThreads > 0 && study.jobs > 1) {
+      return "--atlas-reference-threads needs --jobs 1 (with several jobs each holds a CPU)";
+    }
+    return opt.atlasScene == "free" && opt.atlasContact != "soft"
+               ? "--atlas-contact is the falling scene's floor: the free scene touches nothing"
                : "";
   });
   if (code) return *code;
@@ -267,6 +285,7 @@ int main(int argc, char** argv) {
   }
   applyDefaults(study, opt);
   const AtlasScene scene = *parseAtlasScene(opt.atlasScene);
+  const AtlasContact contact = *parseAtlasContact(opt.atlasContact);
   const std::vector<Task> tasks = gridTasks(opt);
   const std::vector<std::pair<double, int>> points = atlasPoints(opt);
 
@@ -279,14 +298,14 @@ int main(int argc, char** argv) {
                                 return;
                               }
                               const auto [ak, an] = points[i - tasks.size()];
-                              const World w = atlasScene(ak, an, scene);
+                              const World w = atlasScene(ak, an, scene, contact);
                               const AtlasReference reference =
-                                  atlasReference(w, ak, scene, opt.atlas);
+                                  atlasReference(w, ak, scene, opt.atlas, contact);
                               for (IntegratorKind kind : atlasIntegrators(study.quick)) {
                                 atlasPoint(w, ak, an, kind, reference, opt.atlas, atlasRows);
                               }
                             },
                             {&table, &atlasRows});
   if (!ok) return 1;
-  return study.finish(table, parameters(opt, study, scene), {{"atlas", &atlasRows}});
+  return study.finish(table, parameters(opt, study, scene, contact), {{"atlas", &atlasRows}});
 }
