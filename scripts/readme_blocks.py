@@ -25,6 +25,7 @@ BLOCKS = {
     "atlas-summary": "experiments/README.md",
     "atlas-region": "experiments/README.md",
     "atlas-free-summary": "experiments/README.md",
+    "atlas-contact-summary": "experiments/README.md",
     "integrators-table": "solvers/README.md",
     "implicit-steps": "solvers/README.md",
     "crossover": "solvers/README.md",

@@ -12,7 +12,8 @@ from experiments/results/work_precision.csv and its sidecar), <!-- implicit-damp
 <!-- scaling-summary:... --> (cost per simulated second against N, from scaling.csv) and
 <!-- drift-summary:... --> (the long-run drift of energy and angular momentum per integrator,
 from work_precision_drift_summary.csv), the crossover atlas's (atlas-summary and atlas-region
-from every *_atlas.csv; atlas-free-summary from experiments/results/atlas_free/), each in the
+from every *_atlas.csv; atlas-free-summary from experiments/results/atlas_free/;
+atlas-contact-summary from experiments/results/atlas_contact_*/), each in the
 document scripts/readme_blocks.py names. With --check it changes nothing and exits 1 when a
 document differs from what the data gives (ctest runs it so).
 
@@ -303,6 +304,41 @@ def scaling_summary():
 
 # The free scene's atlas (jello-scaling --atlas-scene free) has its own directory.
 ATLAS_FREE = "atlas_free"
+# The falling scene with stiffer floors (jello-scaling --atlas-contact; run-experiments.sh
+# atlas-contact), by setting: the subdirectory each one's runs are in.
+ATLAS_CONTACT = {"k": "atlas_contact_k", "20k": "atlas_contact_20k"}
+FLOOR_WORDS = {"k": "as stiff as the springs (kCollision = k)",
+               "20k": "20 times stiffer than the springs (kCollision = 20 k)"}
+
+
+def stiff_floors():
+    """Where implicit pays on the stiffer floors that have run (for the findings), or ""."""
+    said = []
+    for setting, subdirectory in ATLAS_CONTACT.items():
+        directory = os.path.join(RESULTS, subdirectory)
+        if not (os.path.isdir(directory) and any(f.endswith("_atlas.csv")
+                                                  for f in os.listdir(directory))):
+            continue
+        pays = atlas_pays(subdirectory)
+        said.append(f"with the floor {FLOOR_WORDS[setting]}, " + (
+            "at " + "; ".join(f"N = {n}, k = {k_text(k)} ({name}, {x:.2g}x)"
+                              for n, k, name, x in pays) if pays else "nowhere") +
+            f" (N = {', '.join(str(n) for n in sorted(atlas_sources(subdirectory)))})")
+    return "; " + "; ".join(said) if said else ""
+
+
+def atlas_contact_summary():
+    """The falling scene's atlas per stiffer floor, each as atlas_summary writes it; a floor
+    not run yet says so."""
+    parts = []
+    for setting, subdirectory in ATLAS_CONTACT.items():
+        directory = os.path.join(RESULTS, subdirectory)
+        ran = os.path.isdir(directory) and any(f.endswith("_atlas.csv")
+                                               for f in os.listdir(directory))
+        parts.append(f"**The floor {FLOOR_WORDS[setting]}** (`experiments/results/{subdirectory}/`): "
+                     + ("\n\n" + atlas_summary(subdirectory) if ran else
+                        "not run yet (`scripts/run-experiments.sh atlas-contact`)."))
+    return "\n\n".join(parts)
 
 
 @functools.lru_cache(maxsize=None)
@@ -577,7 +613,7 @@ def findings():
              "falls onto the course's soft floor (400 N/m), " +
              ("only at " + "; ".join(f"N = {n}, k = {k_text(k)} ({name}, {x:.2g}x)"
                                     for n, k, name, x in falling) if falling else "nowhere") +
-             " in the crossover atlas (N = 8, 16, 32; k = 10^2 to 10^8).")
+             " in the crossover atlas (N = 8, 16, 32; k = 10^2 to 10^8)" + stiff_floors() + ".")
     cross = crossover_ms()
     pd = closed_sets.names("Projective")[0]  # the crossover benchmark's subject
     fourth = (f"**How fast**: projective dynamics takes a simulated second of the spinning cube "
@@ -739,6 +775,7 @@ BLOCKS = {"findings": findings,
           "atlas-summary": atlas_summary,
           "atlas-region": atlas_region,
           "atlas-free-summary": lambda: atlas_summary(ATLAS_FREE),
+          "atlas-contact-summary": atlas_contact_summary,
           "experiments-runtime": experiments_runtime}
 
 
