@@ -320,10 +320,18 @@ def stiff_floors():
                                                   for f in os.listdir(directory))):
             continue
         pays = atlas_pays(subdirectory)
+        by_n = atlas_sources(subdirectory)
+        tolerance = next(iter(by_n.values()))[1][0]["parameters"]["atlas"]["tolerance_m"]
+        # Where RK4 at twice the reference's step is more than half the tolerance away, the
+        # cells' verdicts are not to be trusted.
+        uncertain = sorted({float(r["k_N_per_m"]) for rows, _ in by_n.values() for r in rows
+                            if float(r["reference_check_m"]) > 0.5 * tolerance})
         said.append(f"with the floor {FLOOR_WORDS[setting]}, " + (
             "at " + "; ".join(f"N = {n}, k = {k_text(k)} ({name}, {x:.2g}x)"
                               for n, k, name, x in pays) if pays else "nowhere") +
-            f" (N = {', '.join(str(n) for n in sorted(atlas_sources(subdirectory)))})")
+            f" (N = {', '.join(str(n) for n in sorted(by_n))}" +
+            (f"; its RK4 references are not converged to the tolerance from k = "
+             f"{k_text(uncertain[0])}" if uncertain else "") + ")")
     return "; " + "; ".join(said) if said else ""
 
 
@@ -440,7 +448,10 @@ def atlas_summary(subdirectory=""):
             missing = ", ".join(sorted(r["integrator"] + ("" if r["outcome"] == "not_reached"
                                                           else f" ({r['outcome']})")
                                        for r in here if r["outcome"] != "ok"))
-            lines.append(f"| {k_text(k)} | {float(here[0]['w_max_rad_per_s']):,.0f} | {text(e)} | "
+            check = max(float(r["reference_check_m"]) for r in here)
+            uncertain = (f" (reference within {1e3 * check:.2g} mm only)"
+                         if check > 0.5 * first["tolerance_m"] else "")
+            lines.append(f"| {k_text(k)}{uncertain} | {float(here[0]['w_max_rad_per_s']):,.0f} | {text(e)} | "
                          f"{text(o)} | {ratio} | {missing} |")
         lines.append("")
     pays = atlas_pays(subdirectory)

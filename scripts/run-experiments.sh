@@ -104,11 +104,22 @@ draw_free_atlas() {
   gnuplot -e "dir='$out/atlas_free'; atlas_ns='8 16'; atlas_only=1; scene=' (free flight)'" \
     experiments/plots/scaling.gp
 }
+# The stiffer floors' atlases, those that have run.
+draw_contact_atlases() {
+  local contact
+  for contact in k 20k; do
+    if [ -f "$out/atlas_contact_$contact/scaling_atlas.csv" ]; then
+      gnuplot -e "dir='$out/atlas_contact_$contact'; atlas_ns='8'; atlas_only=1; \
+scene=' (floor kCollision = $contact)'" experiments/plots/scaling.gp
+    fi
+  done
+}
 if [ "${1:-}" = charts ]; then
   gnuplot -e "dir='$out'; scenes='$stability_scenes'" experiments/plots/stability.gp
   gnuplot -e "dir='$out'; scenes='$precision_scenes'" experiments/plots/work_precision.gp
   draw_atlas
   draw_free_atlas
+  draw_contact_atlases
   echo "run-experiments: charts redrawn in $out/"
   exit 0
 fi
@@ -185,6 +196,7 @@ if [ "${1:-}" = atlas-contact ]; then
         --jobs 1 --out-dir "$dir"
     fi
   done
+  draw_contact_atlases
   echo "run-experiments: the falling scene's atlas with stiffer floors in $out/atlas_contact_*/"
   exit 0
 fi
