@@ -88,6 +88,24 @@ TEST(AtlasContact, TheFloorsStiffnessSetsTheFastestModeAndTheReferenceStep) {
   EXPECT_GT(lowestCorner(hardRef), lowestCorner(softRef) + 1e-3);
 }
 
+// Against the stiff floor at k = 1e4, RK4 at h w_max = 1 is 3.9 mm from RK4 at twice its step,
+// over a fifth of the 1 cm tolerance: the reference halves its step (the run at the first step
+// its check) until it is within that fifth.
+TEST(AtlasContact, AReferenceNotConvergedHalvesItsStep) {
+  const double k = 1e4;
+  const World hard = atlasScene(k, 8, AtlasScene::Falling, AtlasContact::Stiffer);
+  AtlasSetup setup;
+  const AtlasReference ref =
+      atlasReference(hard, k, AtlasScene::Falling, setup, AtlasContact::Stiffer);
+  EXPECT_LE(ref.check, setup.referenceCheck * setup.tolerance);
+  EXPECT_LE(ref.dt * ref.wMax, 0.5 * setup.referenceHw);  // halved at least once
+  setup.referenceRefinements = 0;                         // as before: h w_max <= 1 alone
+  const AtlasReference once =
+      atlasReference(hard, k, AtlasScene::Falling, setup, AtlasContact::Stiffer);
+  EXPECT_GT(once.check, setup.referenceCheck * setup.tolerance);
+  EXPECT_GT(once.dt, ref.dt);
+}
+
 // The free scene touches nothing: a floor's stiffness for it is a mistake, said before any run.
 TEST(AtlasContact, TheFreeSceneRefusesAFloor) {
   const test::Outcome o = test::run(std::string(JELLO_SCALING) +

@@ -266,9 +266,23 @@ AtlasReference atlasReference(const World& w, double k, AtlasScene scene, const 
       referenceSceneName(scene, contact), k, w.cubeResolution, ref.dt, setup.interval, setup.time};
   ref.samples = referenceFits(w, key, setup, visible);
   key.dt = 2.0 * ref.dt;
-  const std::vector<Fit> check = referenceFits(w, key, setup, visible);
-  for (std::size_t i = 0; i < check.size(); ++i) {
-    ref.check = std::max(ref.check, visible.cornerDistance(check[i], ref.samples[i]));
+  std::vector<Fit> check = referenceFits(w, key, setup, visible);
+  // Halved while RK4 at twice the step is further than setup.referenceCheck of the tolerance
+  // from it, each
+  // halving's check the run before it: RK4's own error is then about a fifteenth of the check.
+  for (int refinement = 0;; ++refinement) {
+    ref.check = 0.0;
+    for (std::size_t i = 0; i < check.size(); ++i) {
+      ref.check = std::max(ref.check, visible.cornerDistance(check[i], ref.samples[i]));
+    }
+    if (ref.check <= setup.referenceCheck * setup.tolerance ||
+        refinement == setup.referenceRefinements) {
+      break;
+    }
+    check = std::move(ref.samples);
+    ref.dt /= 2.0;
+    key.dt = ref.dt;
+    ref.samples = referenceFits(w, key, setup, visible);
   }
   return ref;
 }

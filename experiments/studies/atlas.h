@@ -25,9 +25,16 @@ struct AtlasSetup {
   double time = 1.0;         // s, the window: the throw, the contact and the rebound
   double interval = 0.02;    // s between samples, and the implicit methods' largest step
   double tolerance = 0.01;   // m, at the corners (1% of the cube's edge)
-  double referenceHw = 1.0;  // h w_max of the reference's RK4 steps
-  double runBudget = 20.0;   // wall seconds: a run that would take longer ends the search
-  int halvings = 7;          // step sizes tried per integrator (explicit: below its limit)
+  double referenceHw = 1.0;  // h w_max of the reference's RK4 steps, at most
+  // The reference's step is halved, up to referenceRefinements times, while RK4 at twice it is
+  // further than this fraction of the tolerance from it at the corners (a fifth: RK4's own
+  // error is then about 1% of the tolerance). Measured on the 20-times-stiffer floor at k = 1e5, N
+  // = 8: 40, 3.2, 0.19 and 0.008 mm at h w_max = 1, 1/2, 1/4, 1/8 (fourth order, once the step is
+  // small enough).
+  double referenceCheck = 0.2;
+  int referenceRefinements = 4;
+  double runBudget = 20.0;  // wall seconds: a run that would take longer ends the search
+  int halvings = 7;         // step sizes tried per integrator (explicit: below its limit)
   // Where references are kept (reference_file.h; empty: nowhere): one found there is used, one
   // computed is written there, and while it is computed its last state every `checkpoint` wall
   // seconds, from which a later run resumes.
@@ -85,7 +92,8 @@ struct AtlasReference {
   double check = 0.0;  // m, the largest corner distance from RK4 at twice the reference's step
 };
 // The reference of `scene` at stiffness k (`w`, atlasScene's with `contact`), and its check:
-// RK4 at h w_max <= setup.referenceHw, w_max atlasMaxFrequency's.
+// RK4 at h w_max <= setup.referenceHw (w_max atlasMaxFrequency's), halved while the check is
+// above setup.referenceCheck of the tolerance.
 AtlasReference atlasReference(const World& w, double k, AtlasScene scene, const AtlasSetup& setup,
                               AtlasContact contact = AtlasContact::Soft);
 

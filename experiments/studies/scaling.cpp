@@ -247,6 +247,8 @@ nlohmann::json parameters(const Options& opt, const Study& study, const AtlasSce
              "the least-squares affine map of the rest lattice, compared at the 8 corners"},
             {"reference", "rk4"},
             {"reference_h_w_max", atlas.referenceHw},
+            {"reference_check_max_of_tolerance", atlas.referenceCheck},
+            {"reference_refinements_max", atlas.referenceRefinements},
             {"reference_dir", opt.referenceDir},
             {"reference_threads", atlas.referenceThreads},
             {"run_budget_s", atlas.runBudget},
