@@ -16,13 +16,13 @@ export OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1
 out=experiments/results/viewer_fps.json
 tmp=$(mktemp)
 trap 'rm -f "$tmp"' EXIT
+. scripts/xvfb.sh
 bench() {  # name, world, args...
   local name=$1 world=$2
   shift 2
   echo "bench-viewer: $name" >&2
   local line
-  line=$(env ${BENCH_ENV:-} xvfb-run -a -s "-screen 0 1024x768x24" build/native/bin/jello \
-    "$world" "$@")
+  line=$(xvfb env ${BENCH_ENV:-} build/native/bin/jello "$world" "$@")
   echo "$line" >&2
   printf '%s\t%s\n' "$name" "$line" >>"$tmp"
 }

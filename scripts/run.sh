@@ -15,5 +15,6 @@ fi
 echo "run: no display: recording the showcase (worlds/showcase.w) to frames/ and" \
   "frames/showcase.mp4 under Xvfb"
 mkdir -p frames
-exec xvfb-run -a -s "-screen 0 1024x768x24" "$viewer" worlds/showcase.w --follow --texture builtin \
+. scripts/xvfb.sh
+xvfb "$viewer" worlds/showcase.w --follow --texture builtin \
   --record frames --record-video frames/showcase.mp4 --frames 300 "$@"

@@ -15,7 +15,8 @@ viewer=(build/release/bin/jello worlds/showcase.w --record "$dir" --frames 300 -
 if [ -n "${DISPLAY:-}" ]; then
   "${viewer[@]}"
 else
-  xvfb-run -a -s "-screen 0 1024x768x24" "${viewer[@]}"
+  . scripts/xvfb.sh
+  xvfb "${viewer[@]}"
 fi
 "${PYTHON:-/usr/bin/python3}" - "$dir" experiments/results/showcase_sheet.png <<'PY'
 import os, sys

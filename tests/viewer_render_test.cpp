@@ -29,9 +29,13 @@ std::string jello() {
 // llvmpipe keeps its back buffer (1.2 MB) and driver state past exit, allocated from a driver
 // it has unloaded by then, so LeakSanitizer cannot name it in a suppression. The viewer's own
 // logic is leak-checked in-process by viewer_test.
+// The X authority file is the test's own (-f): xvfb-run's temporary directory can fail to be
+// removed at exit, and xvfb-run then exits 5 whatever the viewer returned (seen in CI).
 std::string headless(const std::string& arguments) {
-  return "ASAN_OPTIONS=detect_leaks=0 xvfb-run -a -s '-screen 0 1024x768x24' " + jello() + " " +
-         arguments;
+  static const test::TempDir authority;
+  return "ASAN_OPTIONS=detect_leaks=0 xvfb-run -a -f " +
+         (authority.path() / "Xauthority").string() + " -s '-screen 0 1024x768x24' " + jello() +
+         " " + arguments;
 }
 std::string world(const char* name) {
   return (test::worldsDir() / name).string();
