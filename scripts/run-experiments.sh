@@ -16,6 +16,10 @@
 # `scripts/run-experiments.sh atlas-contact` runs the falling scene's atlas at N = 8 with the floor
 # as stiff as the springs and 20 times stiffer (--atlas-contact k, 20k), one point at a time,
 # into experiments/results/atlas_contact_k/ and atlas_contact_20k/ (about 20 minutes each).
+# `scripts/run-experiments.sh atlas-slide` runs the friction scene (--atlas-scene slide: thrown
+# down an incline with mu = 0.6, it slides and comes to rest) at N = 8 for k = 1e3, 1e4, 1e5 and
+# at N = 16 for k = 1e4 (a 60 s budget), side by side, one core each, into
+# experiments/results/atlas_slide/ (about 30 minutes on a 2-core VM).
 # `scripts/run-experiments.sh charts` runs nothing: it redraws every chart from the committed CSV.
 # `--ranks K` (with any of the above but charts) runs each program as one MPI job of K ranks
 # (mpirun; on a cluster, inside the allocation): the grid points dealt out over the ranks, one
@@ -24,12 +28,12 @@
 # instead of building the native ones (the tests: build/release/bin).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-usage="usage: scripts/run-experiments.sh [quick | atlas | atlas-free | atlas-contact | charts] [--ranks K]"
+usage="usage: scripts/run-experiments.sh [quick | atlas | atlas-free | atlas-contact | atlas-slide | charts] [--ranks K]"
 mode=
 ranks=
 while [ $# -gt 0 ]; do
   case "$1" in
-    quick | atlas | atlas-free | atlas-contact | charts)
+    quick | atlas | atlas-free | atlas-contact | atlas-slide | charts)
       if [ -n "$mode" ]; then
         echo "run-experiments: '$1' after '$mode': one mode at a time ($usage)" >&2
         exit 2
@@ -114,12 +118,19 @@ scene=' (floor kCollision = $contact)'" experiments/plots/scaling.gp
     fi
   done
 }
+draw_slide_atlas() {
+  if [ -f "$out/atlas_slide/atlas8_atlas.csv" ]; then
+    gnuplot -e "dir='$out/atlas_slide'; atlas_ns='8 16'; atlas_only=1; \
+scene=' (slide with friction)'" experiments/plots/scaling.gp
+  fi
+}
 if [ "${1:-}" = charts ]; then
   gnuplot -e "dir='$out'; scenes='$stability_scenes'" experiments/plots/stability.gp
   gnuplot -e "dir='$out'; scenes='$precision_scenes'" experiments/plots/work_precision.gp
   draw_atlas
   draw_free_atlas
   draw_contact_atlases
+  draw_slide_atlas
   echo "run-experiments: charts redrawn in $out/"
   exit 0
 fi
@@ -198,6 +209,28 @@ if [ "${1:-}" = atlas-contact ]; then
   done
   draw_contact_atlases
   echo "run-experiments: the falling scene's atlas with stiffer floors in $out/atlas_contact_*/"
+  exit 0
+fi
+if [ "${1:-}" = atlas-slide ]; then
+  export OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1
+  slide="$out/atlas_slide"
+  mkdir -p "$slide"
+  common=(--no-grid --atlas-scene slide --jobs 1 --out-dir "$slide")
+  if [ -n "$ranks" ]; then
+    "${launch[@]}" "$bin/jello-scaling" "${common[@]}" --atlas-n 8 --atlas-k 1e3,1e4,1e5 \
+      --name atlas8 --quiet
+    "${launch[@]}" "$bin/jello-scaling" "${common[@]}" --atlas-n 16 --atlas-k 1e4 \
+      --atlas-budget 60 --name atlas16 --quiet
+  else
+    taskset -c 0 "$bin/jello-scaling" "${common[@]}" --atlas-n 8 --atlas-k 1e3,1e4,1e5 \
+      --name atlas8 --quiet &
+    first=$!
+    taskset -c 1 "$bin/jello-scaling" "${common[@]}" --atlas-n 16 --atlas-k 1e4 \
+      --atlas-budget 60 --name atlas16
+    wait "$first"
+  fi
+  draw_slide_atlas
+  echo "run-experiments: the friction scene's atlas in $slide/"
   exit 0
 fi
 # Under --ranks, one point at a time per rank (--jobs 1), quietly (one progress line per rank

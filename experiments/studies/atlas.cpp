@@ -11,6 +11,7 @@
 #include "experiments/studies/study_integrators.h"
 #include "experiments/studies/trajectory_run.h"
 #include "solvers/simulation.h"
+#include "src/base/closed_set.h"
 #include "src/base/parallel.h"
 #include "src/world/integrator_table.h"
 #include "src/world/lattice.h"
@@ -20,22 +21,52 @@ namespace jello::experiments {
 
 using Fit = Eigen::Matrix<double, 3, 4>;
 
+namespace {
+
+constexpr closed_set::Row<AtlasScene> kScenes[] = {
+    {AtlasScene::Falling, "falling",
+     "cube at rest shape thrown at 0.5 m/s and spinning 2 rad/s about z, falling 1.5 m onto the "
+     "floor under gravity, c = 0.25 N*s/m"},
+    {AtlasScene::Free, "free",
+     "cube at rest shape thrown at 0.5 m/s and spinning 2 rad/s about z, no gravity, touching "
+     "nothing within the window, c = 0.25 N*s/m"},
+    {AtlasScene::Slide, "slide",
+     "cube at rest shape set 2 cm above a 20 degree incline and thrown down it at 1 m/s under "
+     "gravity; Coulomb friction mu = 0.6 (slip speed 1 mm/s) on every solid: it lands, slides "
+     "and comes to rest; c = 0.25 N*s/m"},
+};
+
+constexpr double kSlideDegrees = 20.0, kSlideMu = 0.6, kSlideDrop = 0.02, kSlideSpeed = 1.0;
+constexpr double kGravity = 9.81;  // m/s^2, defaultFieldStrength's
+
+}  // namespace
+
 std::optional<AtlasScene> parseAtlasScene(const std::string& name) {
-  if (name == "falling") return AtlasScene::Falling;
-  if (name == "free") return AtlasScene::Free;
-  return std::nullopt;
+  return closed_set::parse(kScenes, name);
 }
 
 std::string sceneName(AtlasScene scene) {
-  return scene == AtlasScene::Falling ? "falling" : "free";
+  return std::string(closed_set::row(kScenes, scene).name);
+}
+
+std::vector<std::string> sceneNames() {
+  std::vector<std::string> names;
+  for (const auto& row : kScenes) names.emplace_back(row.name);
+  return names;
 }
 
 std::string describe(AtlasScene scene) {
-  return scene == AtlasScene::Falling
-             ? "cube at rest shape thrown at 0.5 m/s and spinning 2 rad/s about z, falling 1.5 m "
-               "onto the floor under gravity, c = 0.25 N*s/m"
-             : "cube at rest shape thrown at 0.5 m/s and spinning 2 rad/s about z, no gravity, "
-               "touching nothing within the window, c = 0.25 N*s/m";
+  return std::string(closed_set::row(kScenes, scene).summary);
+}
+
+Vec3 slideNormal() {
+  const double theta = kSlideDegrees * 3.14159265358979323846 / 180.0;
+  return {std::sin(theta), 0.0, std::cos(theta)};
+}
+
+Vec3 slideDownhill() {
+  const double theta = kSlideDegrees * 3.14159265358979323846 / 180.0;
+  return {std::cos(theta), 0.0, -std::sin(theta)};
 }
 
 std::optional<AtlasContact> parseAtlasContact(const std::string& name) {
@@ -74,13 +105,37 @@ std::string referenceSceneName(AtlasScene scene, AtlasContact contact) {
                                        : sceneName(scene) + "-contact-" + contactName(contact);
 }
 
+namespace {
+
+// The incline through (0, 0, -1.3) descending along x (it meets the floor at x = 1.92); the cube
+// aligned with it, its bottom face's centre kSlideDrop above the incline over x = -1.2, moving
+// downhill along the fall line, without spin.
+World slideScene(SceneSpec spec) {
+  const Vec3 n = slideNormal(), t = slideDownhill(), e{0.0, 1.0, 0.0};
+  const Vec3 through{0.0, 0.0, -1.3};
+  spec.plane = Plane{n.x, n.y, n.z, -dot(n, through)};
+  spec.contact.mu = kSlideMu;
+  spec.velocity = {0.0, 0.0, 0.0};
+  spec.spin = 0.0;
+  World w = buildWorld(spec);
+  const Vec3 foot = through + t * (-1.2 / t.x);  // on the incline, at x = -1.2
+  for (std::size_t i = 0; i < w.positions.size(); ++i) {
+    const Vec3 r = w.positions[i] - Vec3{0.5, 0.5, 0.0};  // from the bottom face's centre
+    w.positions[i] = foot + t * r.x + e * r.y + n * (r.z + kSlideDrop);
+    w.velocities[i] = t * kSlideSpeed;
+  }
+  return w;
+}
+
+}  // namespace
+
 World atlasScene(double k, int n, AtlasScene scene, AtlasContact contact) {
   SceneSpec spec = stiffCube(k);  // c = 0.25 N*s/m, no plane
   spec.cubeResolution = n;
   spec.pose = PosePreset::Rest;
   spec.velocity = {0.5, 0.0, 0.0};
-  spec.spin = 2.0;
-  if (scene == AtlasScene::Falling) {
+  spec.spin = 2.0;  // slideScene sets its own
+  if (scene != AtlasScene::Free) {
     spec.field = FieldPreset::Gravity;
     spec.fieldStrength = defaultFieldStrength(FieldPreset::Gravity, spec.mass);
     spec.fieldResolution = 2;  // uniform
@@ -88,6 +143,7 @@ World atlasScene(double k, int n, AtlasScene scene, AtlasContact contact) {
     spec.fieldResolution = 0;
   }
   spec.kCollision = contactStiffness(contact, k);
+  if (scene == AtlasScene::Slide) return slideScene(spec);
   World w = buildWorld(spec);
   // Centred in the box: falling, 1.5 m above the floor (z = -2), reached after about 0.55 s;
   // free, 1 s of drift moves it 0.5 m, its corners (0.87 m from the centre) stay 0.6 m from
@@ -244,12 +300,23 @@ double atlasMaxFrequency(const World& w, AtlasScene scene) {
   State s = initialState(w);
   const double start = maxAngularFrequency(model, s);
   if (scene == AtlasScene::Free) return start;
-  // At rest shape, its lowest points 1 mm below the floor (z = -2).
   const int n = s.numPoints();
-  const double lowest = s.x.tail(n).minCoeff();
-  s.x.tail(n).array() += -2.001 - lowest;
+  if (scene == AtlasScene::Falling) {
+    // At rest shape, its lowest points 1 mm below the floor (z = -2).
+    const double lowest = s.x.tail(n).minCoeff();
+    s.x.tail(n).array() += -2.001 - lowest;
+    s.v.setZero();
+    return std::max(start, maxAngularFrequency(model, s));
+  }
+  // Slide: at rest shape, its bottom face 1 mm inside the incline; and static friction's damper.
+  const Vec3 normal = slideNormal();
+  double lowest = INFINITY;
+  for (int p = 0; p < n; ++p) lowest = std::min(lowest, dot(normal, s.position(p)) + w.plane->d);
+  for (int p = 0; p < n; ++p) State::set(s.x, p, s.position(p) - normal * (lowest + 0.001));
   s.v.setZero();
-  return std::max(start, maxAngularFrequency(model, s));
+  const double lambda = 2.0 * w.cubeResolution * w.mass * kGravity;
+  const double friction = 2.0 * w.contact.mu * lambda / (w.mass * w.contact.slipSpeed);
+  return std::max({start, maxAngularFrequency(model, s), friction});
 }
 
 AtlasReference atlasReference(const World& w, double k, AtlasScene scene, const AtlasSetup& setup,

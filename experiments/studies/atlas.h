@@ -45,12 +45,19 @@ struct AtlasSetup {
 
 // The atlas's scenes: `falling` (the default) is the cube thrown sideways and spinning, falling
 // onto the floor under gravity and bouncing; `free` the same throw and spin without gravity,
-// which touches nothing within the window: only rigid motion and what the spin stretches.
-enum class AtlasScene { Falling, Free };
+// which touches nothing within the window: only rigid motion and what the spin stretches;
+// `slide` (issue 39, the friction scene) the cube thrown down a 20 degree incline with Coulomb
+// friction mu = 0.6 (> tan 20 degrees), landing, sliding and coming to rest on it within its
+// 2 s window (kSlideTime).
+enum class AtlasScene { Falling, Free, Slide };
 std::optional<AtlasScene> parseAtlasScene(const std::string& name);
 std::string sceneName(AtlasScene scene);  // as parseAtlasScene reads it
+std::vector<std::string> sceneNames();
 std::string describe(AtlasScene scene);
-
+inline constexpr double kSlideTime = 2.0;  // s, the slide scene's window
+// The slide scene's incline: its normal (pointing out of the solid) and downhill direction.
+Vec3 slideNormal();
+Vec3 slideDownhill();
 // The floor's penalty contact in the falling scene (issue 39, contact stiffness as an axis): the
 // course's kCollision = 400 N/m (`soft`, the default), as stiff as the lattice's springs (`k`),
 // or 20 k (`20k`, as the stability map's wall scene).
@@ -68,7 +75,10 @@ World atlasScene(double k, int n, AtlasScene scene = AtlasScene::Falling,
 
 // w_max of the scene, contact included: the larger of the lattice's at the start and the cube's
 // resting on the floor (its bottom face 1 mm inside it, every bottom point on a contact spring:
-// the stiffest the contact makes it). The free scene touches nothing: the start's alone.
+// the stiffest the contact makes it). The free scene touches nothing: the start's alone. The
+// slide scene's cube rests on the incline instead, and static friction's damper adds its rate
+// 2 mu lambda / (m eps) (src/PHYSICS.md, "Friction"), lambda bounded by twice the weight of a
+// column of N points.
 double atlasMaxFrequency(const World& w, AtlasScene scene);
 
 // Visible motion: the least-squares affine map x = A r + t of the rest lattice (r centred) onto

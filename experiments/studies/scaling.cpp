@@ -6,7 +6,7 @@
 // Also the crossover atlas (atlas.h): over k and N, each integrator's cost at the largest step
 // that keeps the visible motion within a tolerance.
 //   jello-scaling [--quick] [--n LIST] [--budget S] [--atlas-k LIST] [--atlas-n LIST]
-//                 [--atlas-scene falling|free] [--atlas-contact soft|k|20k]
+//                 [--atlas-scene falling|free|slide] [--atlas-contact soft|k|20k]
 //                 [--atlas-references DIR]
 //                 [--out-dir DIR] [--jobs N]
 #include <CLI/CLI.hpp>
@@ -96,13 +96,14 @@ void addAtlasOptions(CLI::App& app, Options& opt) {
       ->check(jello::cli::positive())
       ->capture_default_str();
   app.add_option("--atlas-scene", opt.atlasScene,
-                 "The atlas's scene: falling (thrown, spinning, onto the floor under gravity) or "
-                 "free (the same throw and spin without gravity: no contact)")
-      ->check(CLI::IsMember({"falling", "free"}))
+                 "The atlas's scene: falling (thrown, spinning, onto the floor under gravity), "
+                 "free (the same throw and spin without gravity: no contact) or slide (thrown down "
+                 "an incline with friction, sliding to rest; its window is 2 s)")
+      ->check(CLI::IsMember(sceneNames()))
       ->capture_default_str();
   app.add_option("--atlas-contact", opt.atlasContact,
-                 "The falling scene's floor: penalty contact of the course's 400 N/m (soft), as "
-                 "stiff as the springs (k) or 20 times stiffer (20k)")
+                 "The falling scene's floor, the slide scene's incline: penalty contact of the "
+                 "course's 400 N/m (soft), as stiff as the springs (k) or 20 times stiffer (20k)")
       ->check(CLI::IsMember({"soft", "k", "20k"}))
       ->capture_default_str();
   app.add_option("--atlas-budget", opt.atlas.runBudget,
@@ -237,9 +238,13 @@ nlohmann::json parameters(const Options& opt, const Study& study, const AtlasSce
             {"k_collision", contact == AtlasContact::Soft      ? "400 N/m"
                             : contact == AtlasContact::AsStiff ? "k"
                                                                : "20 k"},
-            {"w_max",
-             "the larger of the start's and the cube's resting on the floor, contact "
-             "springs included"},
+            {"w_max", scene == AtlasScene::Free ? "the start's"
+                      : scene == AtlasScene::Falling
+                          ? "the larger of the start's and the cube's resting on the floor, "
+                            "contact springs included"
+                          : "the largest of the start's, the cube's resting on the incline, "
+                            "contact springs included, and static friction's damping rate 2 mu "
+                            "lambda / (m eps), lambda twice the weight of a column of N points"},
             {"time_s", atlas.time},
             {"sample_interval_s", atlas.interval},
             {"tolerance_m", atlas.tolerance},
@@ -288,6 +293,7 @@ int main(int argc, char** argv) {
   applyDefaults(study, opt);
   const AtlasScene scene = *parseAtlasScene(opt.atlasScene);
   const AtlasContact contact = *parseAtlasContact(opt.atlasContact);
+  if (scene == AtlasScene::Slide) opt.atlas.time = kSlideTime;
   const std::vector<Task> tasks = gridTasks(opt);
   const std::vector<std::pair<double, int>> points = atlasPoints(opt);
 
