@@ -26,6 +26,8 @@ BLOCKS = {
     "atlas-region": "experiments/README.md",
     "atlas-free-summary": "experiments/README.md",
     "atlas-contact-summary": "experiments/README.md",
+    "atlas-slide-summary": "experiments/README.md",
+    "atlas-trace-summary": "experiments/README.md",
     "integrators-table": "solvers/README.md",
     "implicit-steps": "solvers/README.md",
     "crossover": "solvers/README.md",

@@ -13,7 +13,9 @@ from experiments/results/work_precision.csv and its sidecar), <!-- implicit-damp
 <!-- drift-summary:... --> (the long-run drift of energy and angular momentum per integrator,
 from work_precision_drift_summary.csv), the crossover atlas's (atlas-summary and atlas-region
 from every *_atlas.csv; atlas-free-summary from experiments/results/atlas_free/;
-atlas-contact-summary from experiments/results/atlas_contact_*/), each in the
+atlas-contact-summary from experiments/results/atlas_contact_*/; atlas-slide-summary, the
+friction scene's, from experiments/results/atlas_slide/; atlas-trace-summary, the falling
+scene's visible motion over time, from experiments/results/atlas_trace/), each in the
 document scripts/readme_blocks.py names. With --check it changes nothing and exits 1 when a
 document differs from what the data gives (ctest runs it so).
 
@@ -306,9 +308,11 @@ def scaling_summary():
 ATLAS_FREE = "atlas_free"
 # The falling scene with stiffer floors (jello-scaling --atlas-contact; run-experiments.sh
 # atlas-contact), by setting: the subdirectory each one's runs are in.
-ATLAS_CONTACT = {"k": "atlas_contact_k", "20k": "atlas_contact_20k"}
+ATLAS_CONTACT = {"k": "atlas_contact_k", "20k": "atlas_contact_20k",
+                 "barrier": "atlas_contact_barrier"}
 FLOOR_WORDS = {"k": "as stiff as the springs (kCollision = k)",
-               "20k": "20 times stiffer than the springs (kCollision = 20 k)"}
+               "20k": "20 times stiffer than the springs (kCollision = 20 k)",
+               "barrier": "a log barrier (kappa = k, dhat 5 mm: no point crosses it)"}
 
 
 def stiff_floors():
@@ -347,6 +351,91 @@ def atlas_contact_summary():
                      + ("\n\n" + atlas_summary(subdirectory) if ran else
                         "not run yet (`scripts/run-experiments.sh atlas-contact`)."))
     return "\n\n".join(parts)
+
+
+# The friction scene's atlas (jello-scaling --atlas-scene slide; run-experiments.sh atlas-slide).
+ATLAS_SLIDE = "atlas_slide"
+
+
+def atlas_ran(subdirectory):
+    """True when a subdirectory of the results holds an atlas."""
+    directory = os.path.join(RESULTS, subdirectory)
+    return os.path.isdir(directory) and any(f.endswith("_atlas.csv") for f in os.listdir(directory))
+
+
+def atlas_every_integrator(subdirectory):
+    """Every integrator's outcome at every (N, k) of an atlas: its cost and step where it kept
+    the visible motion, else why not, with the error of the smallest step it finished."""
+    by_n = atlas_sources(subdirectory)
+    columns = [(n, k) for n in sorted(by_n)
+               for k in sorted({float(r["k_N_per_m"]) for r in by_n[n][0]})]
+    rows = {(int(r["n"]), float(r["k_N_per_m"]), r["integrator"]): r
+            for n in by_n for r in by_n[n][0]}
+
+    def cell(r):
+        if r is None:
+            return ""
+        if r["outcome"] == "ok":
+            step = (f"rtol {float(r['rtol']):.0e}" if INTEGRATORS[r["integrator"]]["adaptive"]
+                    else f"dt {float(r['dt_s']):.3g}")
+            return f"{seconds(float(r['wall_per_simulated_s']))} ({step})"
+        error = float(r["visible_error_m"])
+        last = "" if error != error else f", {100 * error:.2g} cm at its last step"
+        return {"not_reached": "not within the tolerance", "budget": "over budget",
+                "never_stable": "never stable"}.get(r["outcome"], r["outcome"]) + last
+
+    lines = ["| integrator | " + " | ".join(f"N = {n}, k = {k_text(k)}" for n, k in columns)
+             + " |", "|---|" + "---|" * len(columns)]
+    for name in ORDER:
+        if any((n, k, name) in rows for n, k in columns):
+            lines.append(f"| `{name}` | " + " | ".join(cell(rows.get((n, k, name)))
+                                                      for n, k in columns) + " |")
+    return "\n".join(lines)
+
+
+def atlas_slide_summary():
+    """The friction scene's atlas: the summary and every integrator's cell; or not run yet."""
+    if not atlas_ran(ATLAS_SLIDE):
+        return "Not run yet (`scripts/run-experiments.sh atlas-slide`)."
+    return (atlas_summary(ATLAS_SLIDE) + "\n\nEvery integrator (wall time per simulated second "
+            "at its largest step within the tolerance; dt or rtol in brackets):\n\n"
+            + atlas_every_integrator(ATLAS_SLIDE))
+
+
+# The falling scene's visible motion over time (jello-scaling --atlas-trace; run-experiments.sh
+# atlas-trace).
+ATLAS_TRACE = "atlas_trace"
+TRACED = ["reference", "implicit", "bdf2", "midpoint", "projective"]
+
+
+def atlas_trace_summary():
+    """Per N: the reference's and a few methods' (at their largest step) flattest moment (the
+    cube's least height) and their largest corner distance from the reference, with when."""
+    path = os.path.join(RESULTS, ATLAS_TRACE, "scaling_trace.csv")
+    if not os.path.exists(path):
+        return "Not run yet (`scripts/run-experiments.sh atlas-trace`)."
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    sidecar = read_sidecar(os.path.join(ATLAS_TRACE, "scaling"))
+    lines = [f"k = {k_text(float(rows[0]['k_N_per_m']))} (commit {sidecar['commit'][:7]}, "
+             f"{sidecar['date_utc'][:10]}, {sidecar['wall_time_s'] / 60:.0f} min):", "",
+             "| N | run | step | least height of the cube (m), at t (s) | its centre then (m) | "
+             "largest corner distance from the reference (m), at t (s) | last t reached (s) |",
+             "|---|---|---|---|---|---|---|"]
+    for n in sorted({int(r["n"]) for r in rows}):
+        for name in TRACED:
+            mine = [r for r in rows if int(r["n"]) == n and r["integrator"] == name]
+            if not mine:
+                continue
+            flat = min(mine, key=lambda r: float(r["height_m"]))
+            far = max(mine, key=lambda r: float(r["corner_distance_m"]))
+            step = f"dt {float(mine[0]['dt_s']):.3g}"
+            miss = ("" if name == "reference" else
+                    f"{float(far['corner_distance_m']):.3g}, {float(far['t_s']):.2f}")
+            lines.append(f"| {n} | {name} | {step} | {float(flat['height_m']):.3f}, "
+                         f"{float(flat['t_s']):.2f} | {float(flat['centre_z_m']):.3f} | {miss} | "
+                         f"{float(mine[-1]['t_s']):.2f} |")
+    return "\n".join(lines)
 
 
 @functools.lru_cache(maxsize=None)
@@ -787,6 +876,8 @@ BLOCKS = {"findings": findings,
           "atlas-region": atlas_region,
           "atlas-free-summary": lambda: atlas_summary(ATLAS_FREE),
           "atlas-contact-summary": atlas_contact_summary,
+          "atlas-slide-summary": atlas_slide_summary,
+          "atlas-trace-summary": atlas_trace_summary,
           "experiments-runtime": experiments_runtime}
 
 

@@ -11,6 +11,7 @@
 #include "experiments/studies/atlas.h"
 #include "experiments/studies/stability_analysis.h"
 #include "src/model.h"
+#include "src/world/contact_law.h"
 #include "tests/test_support.h"
 
 namespace jello::experiments {
@@ -104,6 +105,50 @@ TEST(AtlasContact, AReferenceNotConvergedHalvesItsStep) {
       atlasReference(hard, k, AtlasScene::Falling, setup, AtlasContact::Stiffer);
   EXPECT_GT(once.check, setup.referenceCheck * setup.tolerance);
   EXPECT_GT(once.dt, ref.dt);
+}
+
+// The log barrier's force -b'(d) and stiffness b''(d), b(d) = -kappa (d - dhat)^2 ln(d / dhat)
+// (Li et al. 2020), written out here apart from the model's.
+double barrierForce(double d, double kappa, double dhat) {
+  return kappa * (2.0 * (d - dhat) * std::log(d / dhat) + (d - dhat) * (d - dhat) / d);
+}
+double barrierStiffness(double d, double kappa, double dhat) {
+  const double r = (d - dhat) / d;
+  return -kappa * (2.0 * std::log(d / dhat) + 4.0 * r - r * r);
+}
+
+// With the barrier (kappa = k, dhat 5 mm) the scene's w_max is the cube's resting where the
+// barrier carries twice the weight of a column of points: within Weyl's bound of the lattice's
+// and that distance's barrier stiffness (found here by a log-spaced scan). Its reference is
+// converged like the others' and holds every corner outside the floor, which the soft floor's
+// lets sink in.
+TEST(AtlasContact, TheBarrierKeepsTheCubeOutAndItsRestingStiffnessSetsTheStep) {
+  EXPECT_EQ(parseAtlasContact("barrier"), AtlasContact::Barrier);
+  const double k = 1e3;
+  const int n = 8;
+  const World w = atlasScene(k, n, AtlasScene::Falling, AtlasContact::Barrier);
+  EXPECT_EQ(w.contact.model, ContactModel::Barrier);
+  EXPECT_EQ(w.contact.kappa, k);
+  EXPECT_EQ(w.contact.dhat, kDefaultBarrierDistance);
+  const double load = 2.0 * n * w.mass * 9.81;
+  double d = w.contact.dhat;
+  while (barrierForce(d, k, w.contact.dhat) < load) d *= 1.0 - 1e-6;
+  const double lattice = maxAngularFrequency(Model(w), initialState(w));
+  const double wMax = atlasMaxFrequency(w, AtlasScene::Falling);
+  EXPECT_GT(wMax, lattice);
+  EXPECT_LE(wMax, std::sqrt(lattice * lattice + barrierStiffness(d, k, w.contact.dhat) / w.mass) *
+                      (1.0 + 1e-6));
+
+  AtlasSetup setup;
+  const AtlasReference ref =
+      atlasReference(w, k, AtlasScene::Falling, setup, AtlasContact::Barrier);
+  EXPECT_LE(ref.check, setup.referenceCheck * setup.tolerance);
+  const World soft = atlasScene(k, n, AtlasScene::Falling);
+  const AtlasReference softRef = atlasReference(soft, k, AtlasScene::Falling, setup);
+  std::printf("barrier reference: dt %.3g s (h w_max %.3g), check %.3g m, lowest corner %.5f m\n",
+              ref.dt, ref.dt * ref.wMax, ref.check, lowestCorner(ref));
+  EXPECT_GT(lowestCorner(ref), -2.0);
+  EXPECT_LT(lowestCorner(softRef), -2.0);
 }
 
 // The free scene touches nothing: a floor's stiffness for it is a mistake, said before any run.

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <optional>
 
 #include "experiments/studies/reference_file.h"
@@ -11,146 +12,13 @@
 #include "experiments/studies/study_integrators.h"
 #include "experiments/studies/trajectory_run.h"
 #include "solvers/simulation.h"
-#include "src/base/closed_set.h"
 #include "src/base/parallel.h"
 #include "src/world/integrator_table.h"
 #include "src/world/lattice.h"
-#include "src/world/scene_builder.h"
 
 namespace jello::experiments {
 
 using Fit = Eigen::Matrix<double, 3, 4>;
-
-namespace {
-
-constexpr closed_set::Row<AtlasScene> kScenes[] = {
-    {AtlasScene::Falling, "falling",
-     "cube at rest shape thrown at 0.5 m/s and spinning 2 rad/s about z, falling 1.5 m onto the "
-     "floor under gravity, c = 0.25 N*s/m"},
-    {AtlasScene::Free, "free",
-     "cube at rest shape thrown at 0.5 m/s and spinning 2 rad/s about z, no gravity, touching "
-     "nothing within the window, c = 0.25 N*s/m"},
-    {AtlasScene::Slide, "slide",
-     "cube at rest shape set 2 cm above a 20 degree incline and thrown down it at 1 m/s under "
-     "gravity; Coulomb friction mu = 0.6 (slip speed 1 mm/s) on every solid: it lands, slides "
-     "and comes to rest; c = 0.25 N*s/m"},
-};
-
-constexpr double kSlideDegrees = 20.0, kSlideMu = 0.6, kSlideDrop = 0.02, kSlideSpeed = 1.0;
-constexpr double kGravity = 9.81;  // m/s^2, defaultFieldStrength's
-
-}  // namespace
-
-std::optional<AtlasScene> parseAtlasScene(const std::string& name) {
-  return closed_set::parse(kScenes, name);
-}
-
-std::string sceneName(AtlasScene scene) {
-  return std::string(closed_set::row(kScenes, scene).name);
-}
-
-std::vector<std::string> sceneNames() {
-  std::vector<std::string> names;
-  for (const auto& row : kScenes) names.emplace_back(row.name);
-  return names;
-}
-
-std::string describe(AtlasScene scene) {
-  return std::string(closed_set::row(kScenes, scene).summary);
-}
-
-Vec3 slideNormal() {
-  const double theta = kSlideDegrees * 3.14159265358979323846 / 180.0;
-  return {std::sin(theta), 0.0, std::cos(theta)};
-}
-
-Vec3 slideDownhill() {
-  const double theta = kSlideDegrees * 3.14159265358979323846 / 180.0;
-  return {std::cos(theta), 0.0, -std::sin(theta)};
-}
-
-std::optional<AtlasContact> parseAtlasContact(const std::string& name) {
-  if (name == "soft") return AtlasContact::Soft;
-  if (name == "k") return AtlasContact::AsStiff;
-  if (name == "20k") return AtlasContact::Stiffer;
-  return std::nullopt;
-}
-
-std::string contactName(AtlasContact contact) {
-  switch (contact) {
-    case AtlasContact::Soft:
-      return "soft";
-    case AtlasContact::AsStiff:
-      return "k";
-    case AtlasContact::Stiffer:
-      return "20k";
-  }
-  return "soft";
-}
-
-double contactStiffness(AtlasContact contact, double k) {
-  switch (contact) {
-    case AtlasContact::Soft:
-      return 400.0;  // the course's kCollision
-    case AtlasContact::AsStiff:
-      return k;
-    case AtlasContact::Stiffer:
-      return 20.0 * k;
-  }
-  return 400.0;
-}
-
-std::string referenceSceneName(AtlasScene scene, AtlasContact contact) {
-  return contact == AtlasContact::Soft ? sceneName(scene)
-                                       : sceneName(scene) + "-contact-" + contactName(contact);
-}
-
-namespace {
-
-// The incline through (0, 0, -1.3) descending along x (it meets the floor at x = 1.92); the cube
-// aligned with it, its bottom face's centre kSlideDrop above the incline over x = -1.2, moving
-// downhill along the fall line, without spin.
-World slideScene(SceneSpec spec) {
-  const Vec3 n = slideNormal(), t = slideDownhill(), e{0.0, 1.0, 0.0};
-  const Vec3 through{0.0, 0.0, -1.3};
-  spec.plane = Plane{n.x, n.y, n.z, -dot(n, through)};
-  spec.contact.mu = kSlideMu;
-  spec.velocity = {0.0, 0.0, 0.0};
-  spec.spin = 0.0;
-  World w = buildWorld(spec);
-  const Vec3 foot = through + t * (-1.2 / t.x);  // on the incline, at x = -1.2
-  for (std::size_t i = 0; i < w.positions.size(); ++i) {
-    const Vec3 r = w.positions[i] - Vec3{0.5, 0.5, 0.0};  // from the bottom face's centre
-    w.positions[i] = foot + t * r.x + e * r.y + n * (r.z + kSlideDrop);
-    w.velocities[i] = t * kSlideSpeed;
-  }
-  return w;
-}
-
-}  // namespace
-
-World atlasScene(double k, int n, AtlasScene scene, AtlasContact contact) {
-  SceneSpec spec = stiffCube(k);  // c = 0.25 N*s/m, no plane
-  spec.cubeResolution = n;
-  spec.pose = PosePreset::Rest;
-  spec.velocity = {0.5, 0.0, 0.0};
-  spec.spin = 2.0;  // slideScene sets its own
-  if (scene != AtlasScene::Free) {
-    spec.field = FieldPreset::Gravity;
-    spec.fieldStrength = defaultFieldStrength(FieldPreset::Gravity, spec.mass);
-    spec.fieldResolution = 2;  // uniform
-  } else {
-    spec.fieldResolution = 0;
-  }
-  spec.kCollision = contactStiffness(contact, k);
-  if (scene == AtlasScene::Slide) return slideScene(spec);
-  World w = buildWorld(spec);
-  // Centred in the box: falling, 1.5 m above the floor (z = -2), reached after about 0.55 s;
-  // free, 1 s of drift moves it 0.5 m, its corners (0.87 m from the centre) stay 0.6 m from
-  // the walls.
-  for (Vec3& p : w.positions) p += Vec3{-0.5, -0.5, -0.5};
-  return w;
-}
 
 VisibleMotion::VisibleMotion(int n) {
   const Lattice lattice{n};
@@ -209,9 +77,11 @@ struct Attempt {
 
 // `kind` at dt (cvode: the sample interval) over the window, the visible motion compared with
 // the reference's.
+// `trace`, when given, is called with each sample's time and fit.
 Attempt attempt(const World& w, IntegratorKind kind, double dt, const SolverOptions& options,
                 const AtlasSetup& setup, const VisibleMotion& visible,
-                const AtlasReference& reference) {
+                const AtlasReference& reference,
+                const std::function<void(double, const Fit&)>& trace = nullptr) {
   Simulation sim(w, kind, dt, options);
   const long perSample = std::max(1L, std::lround(setup.interval / dt));
   const long samples = std::lround(setup.time / setup.interval);
@@ -233,8 +103,9 @@ Attempt attempt(const World& w, IntegratorKind kind, double dt, const SolverOpti
       }
     }
     wall += secondsSince(t0);
-    a.error = std::max(a.error, visible.cornerDistance(visible.fit(sim.state()),
-                                                       reference.samples[std::size_t(k)]));
+    const Fit fit = visible.fit(sim.state());
+    a.error = std::max(a.error, visible.cornerDistance(fit, reference.samples[std::size_t(k)]));
+    if (trace) trace(double(k) * setup.interval, fit);
   }
   a.finished = true;
   a.wallPerSecond = wall / setup.time;
@@ -258,8 +129,10 @@ class ThreadsFor {
 
 // RK4 at key.dt over the window from w's initial state: the visible motion at every sample,
 // read from, resumed from and written to the reference directory when there is one.
-std::vector<Fit> referenceFits(const World& w, const TrajectoryKey& key, const AtlasSetup& setup,
-                               const VisibleMotion& visible) {
+// Nothing when a step fails.
+std::optional<std::vector<Fit>> referenceFits(const World& w, const TrajectoryKey& key,
+                                              const AtlasSetup& setup,
+                                              const VisibleMotion& visible) {
   const std::filesystem::path file =
       setup.referenceDir.empty() ? std::filesystem::path() : setup.referenceDir / key.fileName();
   std::vector<Fit> fits;
@@ -281,7 +154,11 @@ std::vector<Fit> referenceFits(const World& w, const TrajectoryKey& key, const A
   for (long k = long(fits.size()); k <= samples; ++k) {
     for (long i = 0; i < perSample; ++i) {
       const StepResult r = sim.step();
-      if (!r.ok) throw std::runtime_error("atlas reference: " + r.message);
+      if (!r.ok) {
+        std::fprintf(stderr, "jello-scaling: the reference at dt = %g s failed: %s\n", key.dt,
+                     r.message.c_str());
+        return std::nullopt;
+      }
     }
     fits.push_back(visible.fit(sim.state()));
     if (!file.empty() && k < samples && secondsSince(saved) >= setup.checkpoint) {
@@ -295,30 +172,6 @@ std::vector<Fit> referenceFits(const World& w, const TrajectoryKey& key, const A
 
 }  // namespace
 
-double atlasMaxFrequency(const World& w, AtlasScene scene) {
-  const Model model(w);
-  State s = initialState(w);
-  const double start = maxAngularFrequency(model, s);
-  if (scene == AtlasScene::Free) return start;
-  const int n = s.numPoints();
-  if (scene == AtlasScene::Falling) {
-    // At rest shape, its lowest points 1 mm below the floor (z = -2).
-    const double lowest = s.x.tail(n).minCoeff();
-    s.x.tail(n).array() += -2.001 - lowest;
-    s.v.setZero();
-    return std::max(start, maxAngularFrequency(model, s));
-  }
-  // Slide: at rest shape, its bottom face 1 mm inside the incline; and static friction's damper.
-  const Vec3 normal = slideNormal();
-  double lowest = INFINITY;
-  for (int p = 0; p < n; ++p) lowest = std::min(lowest, dot(normal, s.position(p)) + w.plane->d);
-  for (int p = 0; p < n; ++p) State::set(s.x, p, s.position(p) - normal * (lowest + 0.001));
-  s.v.setZero();
-  const double lambda = 2.0 * w.cubeResolution * w.mass * kGravity;
-  const double friction = 2.0 * w.contact.mu * lambda / (w.mass * w.contact.slipSpeed);
-  return std::max({start, maxAngularFrequency(model, s), friction});
-}
-
 AtlasReference atlasReference(const World& w, double k, AtlasScene scene, const AtlasSetup& setup,
                               AtlasContact contact) {
   const ThreadsFor threads(setup.referenceThreads);
@@ -331,26 +184,35 @@ AtlasReference atlasReference(const World& w, double k, AtlasScene scene, const 
   const VisibleMotion visible(w.cubeResolution);
   TrajectoryKey key{
       referenceSceneName(scene, contact), k, w.cubeResolution, ref.dt, setup.interval, setup.time};
-  ref.samples = referenceFits(w, key, setup, visible);
-  key.dt = 2.0 * ref.dt;
-  std::vector<Fit> check = referenceFits(w, key, setup, visible);
+  const auto fitsAt = [&](double dt) {
+    key.dt = dt;
+    return referenceFits(w, key, setup, visible);
+  };
+  std::optional<std::vector<Fit>> fine = fitsAt(ref.dt), coarse = fitsAt(2.0 * ref.dt);
   // Halved while RK4 at twice the step is further than setup.referenceCheck of the tolerance
-  // from it, each
-  // halving's check the run before it: RK4's own error is then about a fifteenth of the check.
+  // from it (each halving's check the run before it: RK4's own error is then about a fifteenth
+  // of the check), or while RK4 fails (a point crossing the barrier at the impact).
   for (int refinement = 0;; ++refinement) {
-    ref.check = 0.0;
-    for (std::size_t i = 0; i < check.size(); ++i) {
-      ref.check = std::max(ref.check, visible.cornerDistance(check[i], ref.samples[i]));
+    ref.check = INFINITY;
+    if (fine && coarse) {
+      ref.check = 0.0;
+      for (std::size_t i = 0; i < coarse->size(); ++i) {
+        ref.check = std::max(ref.check, visible.cornerDistance((*coarse)[i], (*fine)[i]));
+      }
     }
-    if (ref.check <= setup.referenceCheck * setup.tolerance ||
-        refinement == setup.referenceRefinements) {
+    if (fine && (ref.check <= setup.referenceCheck * setup.tolerance ||
+                 refinement == setup.referenceRefinements)) {
       break;
     }
-    check = std::move(ref.samples);
+    if (refinement == setup.referenceRefinements) {
+      throw std::runtime_error("atlas reference: RK4 failed at dt = " + std::to_string(ref.dt) +
+                               " s and at every halving of it");
+    }
+    coarse = std::move(fine);
     ref.dt /= 2.0;
-    key.dt = ref.dt;
-    ref.samples = referenceFits(w, key, setup, visible);
+    fine = fitsAt(ref.dt);
   }
+  ref.samples = std::move(*fine);
   return ref;
 }
 
@@ -364,28 +226,50 @@ CsvTable atlasTable() {
                    "reference_check_m"});
 }
 
+namespace {
+
+// The candidates of a search, largest first: explicit steps from 0.9 of the predicted limit
+// (dividing the sample interval), the others from the interval; cvode's tolerances from 1e-2.
+// No steps: an explicit method never stable.
+struct Candidates {
+  std::vector<double> steps, rtols;
+};
+Candidates candidates(const World& w, IntegratorKind kind, double wMax, const AtlasSetup& setup) {
+  Candidates c;
+  if (isAdaptive(kind)) {
+    for (int j = 0; j < setup.halvings; ++j) c.rtols.push_back(std::pow(10.0, -2 - j));
+    return c;
+  }
+  double dt = setup.interval;
+  if (isExplicit(kind)) {
+    const double limit = 0.9 * predictedThreshold(kind, wMax, w.dElastic / w.kElastic);
+    if (limit <= 0.0) return c;
+    dt = setup.interval / std::ceil(setup.interval / limit);
+  }
+  for (int j = 0; j < setup.halvings; ++j, dt /= 2.0) c.steps.push_back(dt);
+  return c;
+}
+
+SolverOptions cvodeAt(double rtol) {
+  SolverOptions options;
+  options.cvode.rtol = rtol;
+  options.cvode.maxStepsPerCall = 100000000;
+  return options;
+}
+
+}  // namespace
+
 void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const AtlasReference& ref,
                 const AtlasSetup& setup, CsvTable& table) {
   const double wMax = ref.wMax;
   const VisibleMotion visible(n);
   const double nan = std::nan("");
-  // The candidates, largest first: explicit steps from 0.9 of the predicted limit (dividing the
-  // sample interval), the others from the interval; cvode's tolerances from 1e-2.
-  std::vector<double> steps, rtols;
-  if (isAdaptive(kind)) {
-    for (int j = 0; j < setup.halvings; ++j) rtols.push_back(std::pow(10.0, -2 - j));
-  } else {
-    double dt = setup.interval;
-    if (isExplicit(kind)) {
-      const double limit = 0.9 * predictedThreshold(kind, wMax, w.dElastic / w.kElastic);
-      if (limit <= 0.0) {
-        table.add({k, long(n), wMax, std::string(integratorName(kind)), nan, nan, 0L, nan, nan, 0L,
-                   std::string("never_stable"), ref.dt, ref.check});
-        return;
-      }
-      dt = setup.interval / std::ceil(setup.interval / limit);
-    }
-    for (int j = 0; j < setup.halvings; ++j, dt /= 2.0) steps.push_back(dt);
+  const Candidates c = candidates(w, kind, wMax, setup);
+  const std::vector<double>&steps = c.steps, &rtols = c.rtols;
+  if (steps.empty() && rtols.empty()) {
+    table.add({k, long(n), wMax, std::string(integratorName(kind)), nan, nan, 0L, nan, nan, 0L,
+               std::string("never_stable"), ref.dt, ref.check});
+    return;
   }
   const std::size_t count = isAdaptive(kind) ? rtols.size() : steps.size();
   long tried = 0;
@@ -397,12 +281,8 @@ void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const Atla
       outcome = "budget";
       break;
     }
-    SolverOptions options;
-    double dt = isAdaptive(kind) ? setup.interval : steps[i];
-    if (isAdaptive(kind)) {
-      options.cvode.rtol = rtols[i];
-      options.cvode.maxStepsPerCall = 100000000;
-    }
+    const SolverOptions options = isAdaptive(kind) ? cvodeAt(rtols[i]) : SolverOptions{};
+    const double dt = isAdaptive(kind) ? setup.interval : steps[i];
     const Attempt a = attempt(w, kind, dt, options, setup, visible, ref);
     ++tried;
     if (!a.finished && a.why == "over the run budget") {
@@ -420,6 +300,36 @@ void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const Atla
   }
   table.add({k, long(n), wMax, std::string(integratorName(kind)), nan, nan, 0L, nan, lastError,
              tried, outcome, ref.dt, ref.check});
+}
+
+CsvTable atlasTraceTable() {
+  return CsvTable({"k_N_per_m", "n", "integrator", "dt_s", "rtol", "t_s", "centre_z_m", "height_m",
+                   "width_m", "corner_distance_m"});
+}
+
+void atlasTrace(const World& w, double k, int n, std::optional<IntegratorKind> kind,
+                const AtlasReference& ref, const AtlasSetup& setup, CsvTable& table) {
+  const VisibleMotion visible(n);
+  const double nan = std::nan("");
+  const auto add = [&](const std::string& name, double dt, double rtol, double t, const Fit& fit) {
+    const Fit& at = ref.samples[std::size_t(std::lround(t / setup.interval))];
+    table.add({k, long(n), name, dt, rtol, t, fit(2, 3), fit(2, 2), fit(0, 0),
+               visible.cornerDistance(fit, at)});
+  };
+  if (!kind) {
+    for (std::size_t i = 0; i < ref.samples.size(); ++i) {
+      add("reference", ref.dt, nan, double(i) * setup.interval, ref.samples[i]);
+    }
+    return;
+  }
+  const Candidates c = candidates(w, *kind, ref.wMax, setup);
+  if (c.steps.empty() && c.rtols.empty()) return;
+  const bool adaptive = isAdaptive(*kind);
+  const double dt = adaptive ? setup.interval : c.steps.front();
+  const double rtol = adaptive ? c.rtols.front() : nan;
+  const std::string name(integratorName(*kind));
+  attempt(w, *kind, dt, adaptive ? cvodeAt(rtol) : SolverOptions{}, setup, visible, ref,
+          [&](double t, const Fit& fit) { add(name, dt, rtol, t, fit); });
 }
 
 }  // namespace jello::experiments

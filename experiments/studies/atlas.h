@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "experiments/studies/atlas_scene.h"
 #include "experiments/studies/csv_table.h"
 #include "solvers/integrator.h"
 #include "src/state.h"
@@ -42,44 +43,6 @@ struct AtlasSetup {
   double checkpoint = 60.0;
   int referenceThreads = 0;  // the model's threads for the reference (0: the runs' own)
 };
-
-// The atlas's scenes: `falling` (the default) is the cube thrown sideways and spinning, falling
-// onto the floor under gravity and bouncing; `free` the same throw and spin without gravity,
-// which touches nothing within the window: only rigid motion and what the spin stretches;
-// `slide` (issue 39, the friction scene) the cube thrown down a 20 degree incline with Coulomb
-// friction mu = 0.6 (> tan 20 degrees), landing, sliding and coming to rest on it within its
-// 2 s window (kSlideTime).
-enum class AtlasScene { Falling, Free, Slide };
-std::optional<AtlasScene> parseAtlasScene(const std::string& name);
-std::string sceneName(AtlasScene scene);  // as parseAtlasScene reads it
-std::vector<std::string> sceneNames();
-std::string describe(AtlasScene scene);
-inline constexpr double kSlideTime = 2.0;  // s, the slide scene's window
-// The slide scene's incline: its normal (pointing out of the solid) and downhill direction.
-Vec3 slideNormal();
-Vec3 slideDownhill();
-// The floor's penalty contact in the falling scene (issue 39, contact stiffness as an axis): the
-// course's kCollision = 400 N/m (`soft`, the default), as stiff as the lattice's springs (`k`),
-// or 20 k (`20k`, as the stability map's wall scene).
-enum class AtlasContact { Soft, AsStiff, Stiffer };
-std::optional<AtlasContact> parseAtlasContact(const std::string& name);
-std::string contactName(AtlasContact contact);            // as parseAtlasContact reads it
-double contactStiffness(AtlasContact contact, double k);  // N/m
-// The name stored references are kept under: the scene's ("falling", "free"), with the
-// contact's after it unless soft ("falling-contact-20k"), so the soft atlas's stay valid.
-std::string referenceSceneName(AtlasScene scene, AtlasContact contact);
-
-// The scene at stiffness k (c = 0.25 N*s/m), N^3 points of 1/512 kg (w_max does not depend on N).
-World atlasScene(double k, int n, AtlasScene scene = AtlasScene::Falling,
-                 AtlasContact contact = AtlasContact::Soft);
-
-// w_max of the scene, contact included: the larger of the lattice's at the start and the cube's
-// resting on the floor (its bottom face 1 mm inside it, every bottom point on a contact spring:
-// the stiffest the contact makes it). The free scene touches nothing: the start's alone. The
-// slide scene's cube rests on the incline instead, and static friction's damper adds its rate
-// 2 mu lambda / (m eps) (src/PHYSICS.md, "Friction"), lambda bounded by twice the weight of a
-// column of N points.
-double atlasMaxFrequency(const World& w, AtlasScene scene);
 
 // Visible motion: the least-squares affine map x = A r + t of the rest lattice (r centred) onto
 // a state, and the largest distance between two such maps at the cube's corners.
@@ -119,5 +82,14 @@ CsvTable atlasTable();
 // next smaller step would have taken longer than the run budget).
 void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const AtlasReference& ref,
                 const AtlasSetup& setup, CsvTable& table);
+
+// The visible motion over time (jello-scaling --atlas-trace, issue 39 item 5): the reference's
+// samples (`kind` empty, integrator "reference") or `kind`'s run at its largest candidate step
+// (cvode: its loosest tolerance), as far as it goes: k, n, integrator, dt_s, rtol, t_s, the
+// fit's centre height centre_z_m, the cube's height height_m (A_zz) and width width_m (A_xx),
+// and its corner distance from the reference's fit.
+CsvTable atlasTraceTable();
+void atlasTrace(const World& w, double k, int n, std::optional<IntegratorKind> kind,
+                const AtlasReference& ref, const AtlasSetup& setup, CsvTable& table);
 
 }  // namespace jello::experiments

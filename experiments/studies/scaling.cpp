@@ -6,8 +6,8 @@
 // Also the crossover atlas (atlas.h): over k and N, each integrator's cost at the largest step
 // that keeps the visible motion within a tolerance.
 //   jello-scaling [--quick] [--n LIST] [--budget S] [--atlas-k LIST] [--atlas-n LIST]
-//                 [--atlas-scene falling|free|slide] [--atlas-contact soft|k|20k]
-//                 [--atlas-references DIR]
+//                 [--atlas-scene falling|free|slide] [--atlas-contact soft|k|20k|barrier]
+//                 [--atlas-references DIR] [--atlas-trace]
 //                 [--out-dir DIR] [--jobs N]
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -47,6 +47,7 @@ struct Options {
   std::string atlasScene = "falling";
   std::string atlasContact = "soft";
   std::string referenceDir;
+  bool atlasTrace = false;
 };
 
 // A point of the resolution grid.
@@ -103,8 +104,9 @@ void addAtlasOptions(CLI::App& app, Options& opt) {
       ->capture_default_str();
   app.add_option("--atlas-contact", opt.atlasContact,
                  "The falling scene's floor, the slide scene's incline: penalty contact of the "
-                 "course's 400 N/m (soft), as stiff as the springs (k) or 20 times stiffer (20k)")
-      ->check(CLI::IsMember({"soft", "k", "20k"}))
+                 "course's 400 N/m (soft), as stiff as the springs (k) or 20 times stiffer (20k), "
+                 "or the log barrier with kappa = k and dhat 5 mm (barrier)")
+      ->check(CLI::IsMember(contactNames()))
       ->capture_default_str();
   app.add_option("--atlas-budget", opt.atlas.runBudget,
                  "Wall seconds of one atlas run beyond which smaller steps are not tried")
@@ -124,6 +126,10 @@ void addAtlasOptions(CLI::App& app, Options& opt) {
       ->check(jello::cli::range(1, 64));
   app.add_flag_function(
       "--no-atlas", [&opt](std::int64_t) { opt.atlasK.clear(); }, "Leave the atlas out");
+  app.add_flag("--atlas-trace", opt.atlasTrace,
+               "Instead of the atlas's search, the visible motion over time (NAME_trace.csv): the "
+               "reference's, and each integrator's at its largest step (cvode: its loosest "
+               "tolerance)");
 }
 
 void applyDefaults(const Study& study, Options& opt) {
@@ -214,8 +220,8 @@ void runTask(const Task& t, const Options& opt, CsvTable& table) {
                    : std::nan("")});
 }
 
-nlohmann::json parameters(const Options& opt, const Study& study, const AtlasScene& scene,
-                          AtlasContact contact) {
+nlohmann::json scalingParameters(const Options& opt, const Study& study, const AtlasScene& scene,
+                                 AtlasContact contact) {
   std::vector<std::string> atlasNames;
   for (IntegratorKind kind : atlasIntegrators(study.quick)) {
     atlasNames.emplace_back(integratorName(kind));
@@ -237,11 +243,13 @@ nlohmann::json parameters(const Options& opt, const Study& study, const AtlasSce
             {"contact", contactName(contact)},
             {"k_collision", contact == AtlasContact::Soft      ? "400 N/m"
                             : contact == AtlasContact::AsStiff ? "k"
-                                                               : "20 k"},
+                            : contact == AtlasContact::Stiffer ? "20 k"
+                                                               : "barrier: kappa = k, dhat 5 mm"},
             {"w_max", scene == AtlasScene::Free ? "the start's"
                       : scene == AtlasScene::Falling
                           ? "the larger of the start's and the cube's resting on the floor, "
-                            "contact springs included"
+                            "contact springs included (the barrier's where it carries twice the "
+                            "weight of a column of N points)"
                           : "the largest of the start's, the cube's resting on the incline, "
                             "contact springs included, and static friction's damping rate 2 mu "
                             "lambda / (m eps), lambda twice the weight of a column of N points"},
@@ -297,23 +305,34 @@ int main(int argc, char** argv) {
   const std::vector<Task> tasks = gridTasks(opt);
   const std::vector<std::pair<double, int>> points = atlasPoints(opt);
 
-  CsvTable table = scalingTable(), atlasRows = atlasTable();
-  const bool ok = study.run(int(tasks.size() + points.size()), "points",
-                            [&](int index) {
-                              const auto i = static_cast<std::size_t>(index);
-                              if (i < tasks.size()) {
-                                runTask(tasks[i], opt, table);
-                                return;
-                              }
-                              const auto [ak, an] = points[i - tasks.size()];
-                              const World w = atlasScene(ak, an, scene, contact);
-                              const AtlasReference reference =
-                                  atlasReference(w, ak, scene, opt.atlas, contact);
-                              for (IntegratorKind kind : atlasIntegrators(study.quick)) {
-                                atlasPoint(w, ak, an, kind, reference, opt.atlas, atlasRows);
-                              }
-                            },
-                            {&table, &atlasRows});
+  CsvTable table = scalingTable(), atlasRows = atlasTable(), traceRows = atlasTraceTable();
+  const bool ok =
+      study.run(int(tasks.size() + points.size()), "points",
+                [&](int index) {
+                  const auto i = static_cast<std::size_t>(index);
+                  if (i < tasks.size()) {
+                    runTask(tasks[i], opt, table);
+                    return;
+                  }
+                  const auto [ak, an] = points[i - tasks.size()];
+                  const World w = atlasScene(ak, an, scene, contact);
+                  const AtlasReference reference = atlasReference(w, ak, scene, opt.atlas, contact);
+                  if (opt.atlasTrace) {
+                    atlasTrace(w, ak, an, std::nullopt, reference, opt.atlas, traceRows);
+                  }
+                  for (IntegratorKind kind : atlasIntegrators(study.quick)) {
+                    if (opt.atlasTrace) {
+                      atlasTrace(w, ak, an, kind, reference, opt.atlas, traceRows);
+                    } else {
+                      atlasPoint(w, ak, an, kind, reference, opt.atlas, atlasRows);
+                    }
+                  }
+                },
+                {&table, &atlasRows, &traceRows});
   if (!ok) return 1;
-  return study.finish(table, parameters(opt, study, scene, contact), {{"atlas", &atlasRows}});
+  nlohmann::json parameters = scalingParameters(opt, study, scene, contact);
+  parameters["atlas"]["trace"] = opt.atlasTrace;
+  return study.finish(
+      table, parameters,
+      {{opt.atlasTrace ? "trace" : "atlas", opt.atlasTrace ? &traceRows : &atlasRows}});
 }
