@@ -393,6 +393,39 @@ def atlas_every_integrator(subdirectory):
     return "\n".join(lines)
 
 
+def slide_finding():
+    """Where implicit pays on the friction scene, for the findings; "" when it has not run."""
+    if not atlas_ran(ATLAS_SLIDE):
+        return ""
+    by_n = atlas_sources(ATLAS_SLIDE)
+    cells = []
+    for n in sorted(by_n):
+        rows = by_n[n][0]
+        for k in sorted({float(r["k_N_per_m"]) for r in rows}):
+            here = [r for r in rows if float(r["k_N_per_m"]) == k]
+            best = atlas_cheapest(here)
+            cells.append(f"N = {n}, k = {k_text(k)}: " +
+                         (f"{best['integrator']} ({seconds(float(best['wall_per_simulated_s']))})"
+                          if best else "none within the budget"))
+    fixed = [name for name in ORDER if not INTEGRATORS[name]["explicit"]
+             and not INTEGRATORS[name]["adaptive"]]
+    outcomes = {name: {r["outcome"] for rows, _ in by_n.values() for r in rows
+                       if r["integrator"] == name} for name in fixed}
+    missed = [name for name in fixed if outcomes[name] == {"not_reached"}]
+    over = [name for name in fixed if "ok" not in outcomes[name] and name not in missed]
+    atlas = next(iter(by_n.values()))[1][0]["parameters"]["atlas"]
+    smallest = atlas["sample_interval_s"] / 2 ** (atlas["steps_tried"] - 1)
+    said = []
+    if missed:
+        said.append(f"{', '.join(missed)} miss it by more than 1 cm at every step tried (down to "
+                    f"dt = {smallest:.2g} s)")
+    if over:
+        said.append(f"{', '.join(over)} {'runs' if len(over) == 1 else 'run'} over the budget "
+                    "before keeping it")
+    return ("; sliding to rest on an incline with friction (mu = 0.6) the cheapest within 1 cm is "
+            + "; ".join(cells) + (" (" + "; ".join(said) + ")" if said else ""))
+
+
 def atlas_slide_summary():
     """The friction scene's atlas: the summary and every integrator's cell; or not run yet."""
     if not atlas_ran(ATLAS_SLIDE):
@@ -713,7 +746,8 @@ def findings():
              "falls onto the course's soft floor (400 N/m), " +
              ("only at " + "; ".join(f"N = {n}, k = {k_text(k)} ({name}, {x:.2g}x)"
                                     for n, k, name, x in falling) if falling else "nowhere") +
-             " in the crossover atlas (N = 8, 16, 32; k = 10^2 to 10^8)" + stiff_floors() + ".")
+             " in the crossover atlas (N = 8, 16, 32; k = 10^2 to 10^8)" + stiff_floors()
+             + slide_finding() + ".")
     cross = crossover_ms()
     pd = closed_sets.names("Projective")[0]  # the crossover benchmark's subject
     fourth = (f"**How fast**: projective dynamics takes a simulated second of the spinning cube "

@@ -10,16 +10,23 @@
 # resumes from its last saved state, and the committed reference is reused, so that a rerun
 # only times the integrators; and redraws the atlas charts.
 # `scripts/run-experiments.sh atlas-free` runs the atlas's second scene (the same throw and spin
-# without gravity: no contact) at N = 8 (one core), then at N = 16 for k = 1e5, 1e6, 1e7 (a 60 s
-# budget, two points at a time) into experiments/results/atlas_free/, and draws its charts
-# (about 8 and 30 minutes on a 2-core VM).
+# without gravity: no contact) at N = 8, then at N = 16 for k = 1e5, 1e6, 1e7 (a 60 s budget),
+# one point at a time on one core (two at a time moved projective's figures by up to 40%), into
+# experiments/results/atlas_free/, and draws its charts (about 10 and 40 minutes on a 2-core VM).
 # `scripts/run-experiments.sh atlas-contact` runs the falling scene's atlas at N = 8 with the floor
-# as stiff as the springs and 20 times stiffer (--atlas-contact k, 20k), one point at a time,
-# into experiments/results/atlas_contact_k/ and atlas_contact_20k/ (about 20 minutes each).
+# as stiff as the springs, 20 times stiffer and as the log barrier (--atlas-contact k, 20k,
+# barrier), one point at a time, into experiments/results/atlas_contact_k/, atlas_contact_20k/
+# and atlas_contact_barrier/ (about 20 minutes each); CONTACTS="20k barrier" runs only those.
 # `scripts/run-experiments.sh atlas-slide` runs the friction scene (--atlas-scene slide: thrown
 # down an incline with mu = 0.6, it slides and comes to rest) at N = 8 for k = 1e3, 1e4, 1e5 and
-# at N = 16 for k = 1e4 (a 60 s budget), side by side, one core each, into
-# experiments/results/atlas_slide/ (about 30 minutes on a 2-core VM).
+# at N = 16 for k = 1e4, side by side, one core each, with a 60 s budget a run (an explicit
+# method's 2 s at the friction-limited step is 10-20 s at N = 8: a 20 s budget cut it by the
+# machine's noise), into experiments/results/atlas_slide/ (about 30 and 60 minutes on a 2-core
+# VM); SLIDE_N=8 or 16 runs one of them.
+# `scripts/run-experiments.sh atlas-trace` runs the falling scene at k = 1e4 for N = 8, 16 and 32
+# with --atlas-trace (the reference's visible motion over time, and each integrator's at its
+# largest step; a 60 s budget a run) into experiments/results/atlas_trace/, and draws it (about
+# 20 minutes on a 2-core VM).
 # `scripts/run-experiments.sh charts` runs nothing: it redraws every chart from the committed CSV.
 # `--ranks K` (with any of the above but charts) runs each program as one MPI job of K ranks
 # (mpirun; on a cluster, inside the allocation): the grid points dealt out over the ranks, one
@@ -28,12 +35,12 @@
 # instead of building the native ones (the tests: build/release/bin).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-usage="usage: scripts/run-experiments.sh [quick | atlas | atlas-free | atlas-contact | atlas-slide | charts] [--ranks K]"
+usage="usage: scripts/run-experiments.sh [quick | atlas | atlas-free | atlas-contact | atlas-slide | atlas-trace | charts] [--ranks K]"
 mode=
 ranks=
 while [ $# -gt 0 ]; do
   case "$1" in
-    quick | atlas | atlas-free | atlas-contact | atlas-slide | charts)
+    quick | atlas | atlas-free | atlas-contact | atlas-slide | atlas-trace | charts)
       if [ -n "$mode" ]; then
         echo "run-experiments: '$1' after '$mode': one mode at a time ($usage)" >&2
         exit 2
@@ -110,11 +117,13 @@ draw_free_atlas() {
 }
 # The stiffer floors' atlases, those that have run.
 draw_contact_atlases() {
-  local contact
-  for contact in k 20k; do
+  local contact what
+  for contact in k 20k barrier; do
+    what="kCollision = $contact"
+    [ "$contact" = barrier ] && what="log barrier"
     if [ -f "$out/atlas_contact_$contact/scaling_atlas.csv" ]; then
       gnuplot -e "dir='$out/atlas_contact_$contact'; atlas_ns='8'; atlas_only=1; \
-scene=' (floor kCollision = $contact)'" experiments/plots/scaling.gp
+scene=' (floor $what)'" experiments/plots/scaling.gp
     fi
   done
 }
@@ -131,6 +140,9 @@ if [ "${1:-}" = charts ]; then
   draw_free_atlas
   draw_contact_atlases
   draw_slide_atlas
+  if [ -f "$out/atlas_trace/scaling_trace.csv" ]; then
+    gnuplot -e "dir='$out/atlas_trace'" experiments/plots/atlas_trace.gp
+  fi
   echo "run-experiments: charts redrawn in $out/"
   exit 0
 fi
@@ -187,8 +199,8 @@ if [ "${1:-}" = atlas-free ]; then
   else
     taskset -c 1 "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 8 --jobs 1 \
       --out-dir "$free"
-    "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 16 --atlas-k 1e5,1e6,1e7 \
-      --atlas-budget 60 --jobs 2 --name atlas16 --out-dir "$free"
+    taskset -c 1 "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 16 \
+      --atlas-k 1e5,1e6,1e7 --atlas-budget 60 --jobs 1 --name atlas16 --out-dir "$free"
   fi
   draw_free_atlas
   echo "run-experiments: the free scene's atlas in $free/"
@@ -196,7 +208,7 @@ if [ "${1:-}" = atlas-free ]; then
 fi
 if [ "${1:-}" = atlas-contact ]; then
   export OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1
-  for contact in k 20k; do
+  for contact in ${CONTACTS:-k 20k barrier}; do
     dir="$out/atlas_contact_$contact"
     mkdir -p "$dir"
     if [ -n "$ranks" ]; then
@@ -215,22 +227,33 @@ if [ "${1:-}" = atlas-slide ]; then
   export OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1
   slide="$out/atlas_slide"
   mkdir -p "$slide"
-  common=(--no-grid --atlas-scene slide --jobs 1 --out-dir "$slide")
+  common=(--no-grid --atlas-scene slide --atlas-budget 60 --jobs 1 --out-dir "$slide")
+  eight=(--atlas-n 8 --atlas-k 1e3,1e4,1e5 --name atlas8)
+  sixteen=(--atlas-n 16 --atlas-k 1e4 --name atlas16)
   if [ -n "$ranks" ]; then
-    "${launch[@]}" "$bin/jello-scaling" "${common[@]}" --atlas-n 8 --atlas-k 1e3,1e4,1e5 \
-      --name atlas8 --quiet
-    "${launch[@]}" "$bin/jello-scaling" "${common[@]}" --atlas-n 16 --atlas-k 1e4 \
-      --atlas-budget 60 --name atlas16 --quiet
+    [ "${SLIDE_N:-8}" = 8 ] && "${launch[@]}" "$bin/jello-scaling" "${common[@]}" "${eight[@]}" --quiet
+    [ "${SLIDE_N:-16}" = 16 ] && "${launch[@]}" "$bin/jello-scaling" "${common[@]}" "${sixteen[@]}" \
+      --quiet
+  elif [ -n "${SLIDE_N:-}" ]; then
+    if [ "$SLIDE_N" = 8 ]; then set -- "${eight[@]}"; else set -- "${sixteen[@]}"; fi
+    taskset -c 0 "$bin/jello-scaling" "${common[@]}" "$@"
   else
-    taskset -c 0 "$bin/jello-scaling" "${common[@]}" --atlas-n 8 --atlas-k 1e3,1e4,1e5 \
-      --name atlas8 --quiet &
+    taskset -c 0 "$bin/jello-scaling" "${common[@]}" "${eight[@]}" --quiet &
     first=$!
-    taskset -c 1 "$bin/jello-scaling" "${common[@]}" --atlas-n 16 --atlas-k 1e4 \
-      --atlas-budget 60 --name atlas16
+    taskset -c 1 "$bin/jello-scaling" "${common[@]}" "${sixteen[@]}"
     wait "$first"
   fi
   draw_slide_atlas
   echo "run-experiments: the friction scene's atlas in $slide/"
+  exit 0
+fi
+if [ "${1:-}" = atlas-trace ]; then
+  export OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1
+  mkdir -p "$out/atlas_trace"
+  "${launch[@]}" "$bin/jello-scaling" --no-grid --atlas-trace --atlas-n 8,16,32 --atlas-k 1e4 \
+    --atlas-budget 60 --jobs 1 ${ranks:+--quiet} --out-dir "$out/atlas_trace"
+  gnuplot -e "dir='$out/atlas_trace'" experiments/plots/atlas_trace.gp
+  echo "run-experiments: the falling scene's visible motion over time in $out/atlas_trace/"
   exit 0
 fi
 # Under --ranks, one point at a time per rank (--jobs 1), quietly (one progress line per rank

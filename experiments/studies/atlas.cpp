@@ -205,8 +205,8 @@ AtlasReference atlasReference(const World& w, double k, AtlasScene scene, const 
       break;
     }
     if (refinement == setup.referenceRefinements) {
-      throw std::runtime_error("atlas reference: RK4 failed at dt = " + std::to_string(ref.dt) +
-                               " s and at every halving of it");
+      throw AtlasReferenceFailed("atlas reference: RK4 failed at dt = " + std::to_string(ref.dt) +
+                                 " s and at every halving of it");
     }
     coarse = std::move(fine);
     ref.dt /= 2.0;
@@ -300,6 +300,12 @@ void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const Atla
   }
   table.add({k, long(n), wMax, std::string(integratorName(kind)), nan, nan, 0L, nan, lastError,
              tried, outcome, ref.dt, ref.check});
+}
+
+void atlasNoReference(double k, int n, double wMax, IntegratorKind kind, CsvTable& table) {
+  const double nan = std::nan("");
+  table.add({k, long(n), wMax, std::string(integratorName(kind)), nan, nan, 0L, nan, nan, 0L,
+             std::string("no_reference"), nan, nan});
 }
 
 CsvTable atlasTraceTable() {

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <filesystem>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,14 @@ struct AtlasReference {
   double dt = 0.0;                                   // s
   double check = 0.0;  // m, the largest corner distance from RK4 at twice the reference's step
 };
+// What atlasReference throws when RK4 fails at its step and at every halving of it (a point
+// crossing a barrier too soft for the impact): the point has no reference.
+struct AtlasReferenceFailed : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+// A point without a reference: a row for `kind` with outcome "no_reference".
+void atlasNoReference(double k, int n, double wMax, IntegratorKind kind, CsvTable& table);
+
 // The reference of `scene` at stiffness k (`w`, atlasScene's with `contact`), and its check:
 // RK4 at h w_max <= setup.referenceHw (w_max atlasMaxFrequency's), halved while the check is
 // above setup.referenceCheck of the tolerance.

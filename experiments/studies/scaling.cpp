@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -220,6 +221,33 @@ void runTask(const Task& t, const Options& opt, CsvTable& table) {
                    : std::nan("")});
 }
 
+// One point of the atlas: its reference, then each integrator's search (--atlas-trace: each
+// one's run at its largest step). A point whose reference fails is reported without one
+// (outcome no_reference) and the run goes on.
+void runAtlasPoint(double ak, int an, AtlasScene scene, AtlasContact contact, const Options& opt,
+                   bool quick, CsvTable& atlasRows, CsvTable& traceRows) {
+  const World w = atlasScene(ak, an, scene, contact);
+  std::optional<AtlasReference> found;
+  try {
+    found = atlasReference(w, ak, scene, opt.atlas, contact);
+  } catch (const AtlasReferenceFailed& e) {
+    std::fprintf(stderr, "jello-scaling: k = %g, N = %d: %s\n", ak, an, e.what());
+    for (IntegratorKind kind : atlasIntegrators(quick)) {
+      atlasNoReference(ak, an, atlasMaxFrequency(w, scene), kind, atlasRows);
+    }
+    return;
+  }
+  const AtlasReference& reference = *found;
+  if (opt.atlasTrace) atlasTrace(w, ak, an, std::nullopt, reference, opt.atlas, traceRows);
+  for (IntegratorKind kind : atlasIntegrators(quick)) {
+    if (opt.atlasTrace) {
+      atlasTrace(w, ak, an, kind, reference, opt.atlas, traceRows);
+    } else {
+      atlasPoint(w, ak, an, kind, reference, opt.atlas, atlasRows);
+    }
+  }
+}
+
 nlohmann::json scalingParameters(const Options& opt, const Study& study, const AtlasScene& scene,
                                  AtlasContact contact) {
   std::vector<std::string> atlasNames;
@@ -315,18 +343,7 @@ int main(int argc, char** argv) {
                     return;
                   }
                   const auto [ak, an] = points[i - tasks.size()];
-                  const World w = atlasScene(ak, an, scene, contact);
-                  const AtlasReference reference = atlasReference(w, ak, scene, opt.atlas, contact);
-                  if (opt.atlasTrace) {
-                    atlasTrace(w, ak, an, std::nullopt, reference, opt.atlas, traceRows);
-                  }
-                  for (IntegratorKind kind : atlasIntegrators(study.quick)) {
-                    if (opt.atlasTrace) {
-                      atlasTrace(w, ak, an, kind, reference, opt.atlas, traceRows);
-                    } else {
-                      atlasPoint(w, ak, an, kind, reference, opt.atlas, atlasRows);
-                    }
-                  }
+                  runAtlasPoint(ak, an, scene, contact, opt, study.quick, atlasRows, traceRows);
                 },
                 {&table, &atlasRows, &traceRows});
   if (!ok) return 1;
