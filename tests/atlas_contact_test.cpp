@@ -151,6 +151,30 @@ TEST(AtlasContact, TheBarrierKeepsTheCubeOutAndItsRestingStiffnessSetsTheStep) {
   EXPECT_LT(lowestCorner(softRef), -2.0);
 }
 
+// A barrier as soft as k = 1e2 cannot stop the falling column in floating point: RK4 crosses it
+// at the impact at its step and at every halving, the reference fails (AtlasReferenceFailed),
+// and jello-scaling reports that point's integrators as no_reference and finishes the run.
+TEST(AtlasContact, AReferenceThatFailsIsReportedAndTheRunGoesOn) {
+  const double k = 1e2;
+  const World w = atlasScene(k, 8, AtlasScene::Falling, AtlasContact::Barrier);
+  EXPECT_THROW(atlasReference(w, k, AtlasScene::Falling, AtlasSetup{}, AtlasContact::Barrier),
+               AtlasReferenceFailed);
+  const test::TempDir dir;
+  const test::Outcome o = test::run(std::string(JELLO_SCALING) +
+                                    " --quick --no-grid --atlas-contact barrier --atlas-k 1e2 "
+                                    "--out-dir " +
+                                    dir.path().string());
+  ASSERT_EQ(o.code, 0) << o.output;
+  EXPECT_NE(o.output.find("RK4 failed"), std::string::npos) << o.output;
+  const std::string csv = test::readFile(dir.path() / "scaling_atlas.csv");
+  std::size_t rows = 0;
+  for (std::size_t at = csv.find("no_reference"); at != std::string::npos;
+       at = csv.find("no_reference", at + 1)) {
+    ++rows;
+  }
+  EXPECT_EQ(rows, atlasIntegrators(true).size()) << csv;
+}
+
 // The free scene touches nothing: a floor's stiffness for it is a mistake, said before any run.
 TEST(AtlasContact, TheFreeSceneRefusesAFloor) {
   const test::Outcome o = test::run(std::string(JELLO_SCALING) +
