@@ -127,9 +127,13 @@ scene=' (floor $what)'" experiments/plots/scaling.gp
     fi
   done
 }
+# The friction scene's charts, for each N where a method kept the slide (none at N = 16).
 draw_slide_atlas() {
+  local ns
   if [ -f "$out/atlas_slide/atlas8_atlas.csv" ]; then
-    gnuplot -e "dir='$out/atlas_slide'; atlas_ns='8 16'; atlas_only=1; \
+    ns=$(awk -F, 'FNR > 1 && $11 == "ok" { print $2 }' "$out"/atlas_slide/*_atlas.csv | sort -nu |
+      tr '\n' ' ')
+    gnuplot -e "dir='$out/atlas_slide'; atlas_ns='$ns'; atlas_only=1; \
 scene=' (slide with friction)'" experiments/plots/scaling.gp
   fi
 }
