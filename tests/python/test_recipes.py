@@ -43,6 +43,9 @@ DEFINE_OR_PICK = {
     "experiments/python/energy_over_time.py",
     # The reference and implicit's variants ('projective' there is the preconditioner).
     "scripts/integrator-table.py",
+    # The trace chart's picks: two first-order steps that lose the rebound (backward Euler's and
+    # projective's) and a second-order one that keeps part of it (BDF2).
+    "experiments/plots/atlas_trace.gp",
 }
 
 
