@@ -250,6 +250,14 @@ Candidates candidates(const World& w, IntegratorKind kind, double wMax, const At
   return c;
 }
 
+// The row of an integrator not run at a point: `outcome` says why.
+void addUnrun(CsvTable& table, double k, int n, double wMax, IntegratorKind kind,
+              const std::string& outcome, double referenceDt, double referenceCheck) {
+  const double nan = std::nan("");
+  table.add({k, long(n), wMax, std::string(integratorName(kind)), nan, nan, 0L, nan, nan, 0L,
+             outcome, referenceDt, referenceCheck});
+}
+
 SolverOptions cvodeAt(double rtol) {
   SolverOptions options;
   options.cvode.rtol = rtol;
@@ -267,8 +275,7 @@ void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const Atla
   const Candidates c = candidates(w, kind, wMax, setup);
   const std::vector<double>&steps = c.steps, &rtols = c.rtols;
   if (steps.empty() && rtols.empty()) {
-    table.add({k, long(n), wMax, std::string(integratorName(kind)), nan, nan, 0L, nan, nan, 0L,
-               std::string("never_stable"), ref.dt, ref.check});
+    addUnrun(table, k, n, wMax, kind, "never_stable", ref.dt, ref.check);
     return;
   }
   const std::size_t count = isAdaptive(kind) ? rtols.size() : steps.size();
@@ -303,9 +310,7 @@ void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const Atla
 }
 
 void atlasNoReference(double k, int n, double wMax, IntegratorKind kind, CsvTable& table) {
-  const double nan = std::nan("");
-  table.add({k, long(n), wMax, std::string(integratorName(kind)), nan, nan, 0L, nan, nan, 0L,
-             std::string("no_reference"), nan, nan});
+  addUnrun(table, k, n, wMax, kind, "no_reference", std::nan(""), std::nan(""));
 }
 
 CsvTable atlasTraceTable() {

@@ -27,7 +27,6 @@ constexpr closed_set::Row<AtlasScene> kScenes[] = {
 };
 
 constexpr double kSlideDegrees = 20.0, kSlideMu = 0.6, kSlideDrop = 0.02, kSlideSpeed = 1.0;
-constexpr double kGravity = 9.81;  // m/s^2, defaultFieldStrength's
 
 }  // namespace
 
@@ -40,9 +39,7 @@ std::string sceneName(AtlasScene scene) {
 }
 
 std::vector<std::string> sceneNames() {
-  std::vector<std::string> names;
-  for (const auto& row : kScenes) names.emplace_back(row.name);
-  return names;
+  return closed_set::nameList(kScenes);
 }
 
 std::string describe(AtlasScene scene) {
@@ -86,9 +83,7 @@ std::string contactName(AtlasContact contact) {
 }
 
 std::vector<std::string> contactNames() {
-  std::vector<std::string> names;
-  for (const auto& row : kContacts) names.emplace_back(row.name);
-  return names;
+  return closed_set::nameList(kContacts);
 }
 
 double contactStiffness(AtlasContact contact, double k) {
@@ -158,7 +153,7 @@ namespace {
 // N: what a bottom point of the cube at rest carries at most, bounded by twice the weight of a
 // column of N points.
 double columnLoad(const World& w) {
-  return 2.0 * w.cubeResolution * w.mass * kGravity;
+  return 2.0 * w.cubeResolution * defaultFieldStrength(FieldPreset::Gravity, w.mass);
 }
 
 // m: the bottom face's signed distance from the solid where w_max is taken: 1 mm inside for the

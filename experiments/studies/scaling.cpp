@@ -232,8 +232,9 @@ void runAtlasPoint(double ak, int an, AtlasScene scene, AtlasContact contact, co
     found = atlasReference(w, ak, scene, opt.atlas, contact);
   } catch (const AtlasReferenceFailed& e) {
     std::fprintf(stderr, "jello-scaling: k = %g, N = %d: %s\n", ak, an, e.what());
+    const double wMax = atlasMaxFrequency(w, scene);
     for (IntegratorKind kind : atlasIntegrators(quick)) {
-      atlasNoReference(ak, an, atlasMaxFrequency(w, scene), kind, atlasRows);
+      atlasNoReference(ak, an, wMax, kind, atlasRows);
     }
     return;
   }

@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace jello::closed_set {
 
@@ -59,6 +60,14 @@ std::string names(const Rows& rows, std::string_view separator = ", ") {
     if (!list.empty()) list += separator;
     list += row.name;
   }
+  return list;
+}
+
+// Every row's name, in the table's order (for a command line's list of choices).
+template <class Rows>
+std::vector<std::string> nameList(const Rows& rows) {
+  std::vector<std::string> list;
+  for (const auto& row : rows) list.emplace_back(row.name);
   return list;
 }
 
