@@ -315,13 +315,17 @@ FLOOR_WORDS = {"k": "as stiff as the springs (kCollision = k)",
                "barrier": "a log barrier (kappa = k, dhat 5 mm: no point crosses it)"}
 
 
+def atlas_ran(subdirectory):
+    """True when a subdirectory of the results holds an atlas."""
+    directory = os.path.join(RESULTS, subdirectory)
+    return os.path.isdir(directory) and any(f.endswith("_atlas.csv") for f in os.listdir(directory))
+
+
 def stiff_floors():
     """Where implicit pays on the stiffer floors that have run (for the findings), or ""."""
     said = []
     for setting, subdirectory in ATLAS_CONTACT.items():
-        directory = os.path.join(RESULTS, subdirectory)
-        if not (os.path.isdir(directory) and any(f.endswith("_atlas.csv")
-                                                  for f in os.listdir(directory))):
+        if not atlas_ran(subdirectory):
             continue
         pays = atlas_pays(subdirectory)
         by_n = atlas_sources(subdirectory)
@@ -344,9 +348,7 @@ def atlas_contact_summary():
     not run yet says so."""
     parts = []
     for setting, subdirectory in ATLAS_CONTACT.items():
-        directory = os.path.join(RESULTS, subdirectory)
-        ran = os.path.isdir(directory) and any(f.endswith("_atlas.csv")
-                                               for f in os.listdir(directory))
+        ran = atlas_ran(subdirectory)
         parts.append(f"**The floor {FLOOR_WORDS[setting]}** (`experiments/results/{subdirectory}/`): "
                      + ("\n\n" + atlas_summary(subdirectory) if ran else
                         "not run yet (`scripts/run-experiments.sh atlas-contact`)."))
@@ -355,12 +357,9 @@ def atlas_contact_summary():
 
 # The friction scene's atlas (jello-scaling --atlas-scene slide; run-experiments.sh atlas-slide).
 ATLAS_SLIDE = "atlas_slide"
-
-
-def atlas_ran(subdirectory):
-    """True when a subdirectory of the results holds an atlas."""
-    directory = os.path.join(RESULTS, subdirectory)
-    return os.path.isdir(directory) and any(f.endswith("_atlas.csv") for f in os.listdir(directory))
+# The methods that are neither explicit nor adaptive, in the table's order.
+FIXED_STEP_IMPLICIT = [name for name in ORDER if not INTEGRATORS[name]["explicit"]
+                       and not INTEGRATORS[name]["adaptive"]]
 
 
 def atlas_every_integrator(subdirectory):
@@ -408,8 +407,7 @@ def slide_finding():
             cells.append(f"N = {n}, k = {k_text(k)}: " +
                          (f"{best['integrator']} ({seconds(float(best['wall_per_simulated_s']))})"
                           if best else "none within the budget"))
-    fixed = [name for name in ORDER if not INTEGRATORS[name]["explicit"]
-             and not INTEGRATORS[name]["adaptive"]]
+    fixed = FIXED_STEP_IMPLICIT
     outcomes = {name: {r["outcome"] for rows, _ in by_n.values() for r in rows
                        if r["integrator"] == name} for name in fixed}
     missed = [name for name in fixed if "ok" not in outcomes[name]
@@ -442,8 +440,7 @@ def atlas_slide_summary():
 ATLAS_TRACE = "atlas_trace"
 # The reference and the fixed-step implicit methods (the explicit ones' largest step is their
 # stability limit's, and cvode's its loosest tolerance: neither is what the atlas's misses are).
-TRACED = ["reference"] + [name for name in ORDER if not INTEGRATORS[name]["explicit"]
-                          and not INTEGRATORS[name]["adaptive"]]
+TRACED = ["reference"] + FIXED_STEP_IMPLICIT
 
 
 def atlas_trace_summary():
@@ -577,7 +574,6 @@ def atlas_summary(subdirectory=""):
             if e and o:
                 x = float(e["wall_per_simulated_s"]) / float(o["wall_per_simulated_s"])
                 ratio = f"{x:.2g}x faster" if x >= 1 else f"{1 / x:.2g}x slower"
-
             referenced = [float(r["reference_check_m"]) for r in here
                           if r["outcome"] != "no_reference"]
             check = max(referenced, default=None)
