@@ -234,13 +234,14 @@ if [ "${1:-}" = atlas-slide ]; then
   common=(--no-grid --atlas-scene slide --atlas-budget 60 --jobs 1 --out-dir "$slide")
   eight=(--atlas-n 8 --atlas-k 1e3,1e4,1e5 --name atlas8)
   sixteen=(--atlas-n 16 --atlas-k 1e4 --name atlas16)
-  if [ -n "$ranks" ]; then
-    [ "${SLIDE_N:-8}" = 8 ] && "${launch[@]}" "$bin/jello-scaling" "${common[@]}" "${eight[@]}" --quiet
-    [ "${SLIDE_N:-16}" = 16 ] && "${launch[@]}" "$bin/jello-scaling" "${common[@]}" "${sixteen[@]}" \
-      --quiet
-  elif [ -n "${SLIDE_N:-}" ]; then
-    if [ "$SLIDE_N" = 8 ]; then set -- "${eight[@]}"; else set -- "${sixteen[@]}"; fi
-    taskset -c 0 "$bin/jello-scaling" "${common[@]}" "$@"
+  if [ -n "$ranks" ] || [ -n "${SLIDE_N:-}" ]; then
+    # One after the other: each an MPI job, or the one SLIDE_N names, on one core.
+    pin=(taskset -c 0)
+    if [ -n "$ranks" ]; then pin=(); fi
+    for n in ${SLIDE_N:-8 16}; do
+      if [ "$n" = 8 ]; then set -- "${eight[@]}"; else set -- "${sixteen[@]}"; fi
+      "${pin[@]}" "${launch[@]}" "$bin/jello-scaling" "${common[@]}" "$@" ${ranks:+--quiet}
+    done
   else
     taskset -c 0 "$bin/jello-scaling" "${common[@]}" "${eight[@]}" --quiet &
     first=$!
