@@ -16,11 +16,7 @@
 namespace jello::experiments {
 namespace {
 
-Vec3 meanVelocity(const State& s) {
-  Vec3 v{0, 0, 0};
-  for (int p = 0; p < s.numPoints(); ++p) v = v + s.velocity(p);
-  return v * (1.0 / s.numPoints());
-}
+using test::meanVelocity;
 
 // The least signed distance of any point to the incline, m.
 double clearance(const World& w, const State& s) {

@@ -25,6 +25,7 @@ namespace jello {
 namespace {
 
 using test::centre;
+using test::meanVelocity;
 
 constexpr double kG = 9.81;
 constexpr double kPi = 3.14159265358979323846;
@@ -59,13 +60,6 @@ World onTheIncline(World w, double theta, const Vec3& foot, double gap) {
     p = foot + t * r.x + Vec3{0.0, 1.0, 0.0} * r.y + n * (r.z + gap);
   }
   return w;
-}
-
-Vec3 meanVelocity(const State& s) {
-  Vec3 c{0, 0, 0};
-  const int n = s.numPoints();
-  for (int p = 0; p < n; ++p) c = c + s.velocity(p);
-  return c * (1.0 / n);
 }
 
 // Runs to time T, calling sample(state) after every step; fails the test on a failed step.

@@ -76,6 +76,13 @@ Vec3 centre(const State& s) {
   return c * (1.0 / n);
 }
 
+Vec3 meanVelocity(const State& s) {
+  Vec3 v{0, 0, 0};
+  const int n = s.numPoints();
+  for (int p = 0; p < n; ++p) v = v + s.velocity(p);
+  return v * (1.0 / n);
+}
+
 ModelSpec singleSpring(double stiffness, double damping, double rest, double mass) {
   ModelSpec spec;
   spec.numPoints = 2;

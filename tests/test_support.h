@@ -53,6 +53,8 @@ ModelSpec onePoint(const ContactConstants& k);
 State pointAt(const Vec3& x, const Vec3& v);
 // The mean of the points' positions (m): the centre of mass of equal masses.
 Vec3 centre(const State& s);
+// The mean velocity of the points (equal masses: the centre of mass's).
+Vec3 meanVelocity(const State& s);
 
 // Two points of mass m joined by a spring of rest length 0: the force k (x_j - x_i) is exactly
 // linear, so the relative motion is an undamped isotropic oscillator with w = sqrt(2k/m). The
