@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   cmake ninja-build g++ pkg-config ccache
-  libeigen3-dev libsuitesparse-dev libopenblas0-pthread libsundials-dev
+  libeigen3-dev libsuitesparse-dev libopenblas0-pthread libsundials-dev libfftw3-dev
   freeglut3-dev libgl1-mesa-dev libglu1-mesa-dev xvfb xauth libstb-dev libimgui-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libspectra-dev libcli11-dev nlohmann-json3-dev gnuplot-nox libopenmpi-dev openmpi-bin

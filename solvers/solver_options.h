@@ -141,6 +141,17 @@ struct ProjectiveOptions {
   // every contact). A contact whose weight is under kLightContactRatio of its point's diagonal
   // leaves the factor as it is, and each global solve is corrected on the coarse nodes.
   int coarseNodes = 4;
+  // On a lattice of at least this many points per edge whose springs are the whole lattice
+  // (solvers/system/lattice_spectral.h), a coordinate with no contact weight in its matrix solves
+  // the global step with the cosine transform's bound P' of M/h^2 + L instead of a CHOLMOD
+  // factor: no factorization, O(n log n) a solve (0: never). 8^3 keeps its factor (a solve of
+  // microseconds); from 16^3 the bound, corrected, converges as fast (README, "Projective at
+  // 32^3").
+  int spectralFrom = 16;
+  // Neumann corrections of the bound's solve toward P^-1 (each one more solve and a product with
+  // P' - P, near the faces only): one measured best (at 32^3, ten iterations within 0.0012 of
+  // backward Euler's step against the factor's 0.00127; none 0.00206; two 0.00125).
+  int spectralCorrections = 1;
 };
 
 struct SolverOptions {

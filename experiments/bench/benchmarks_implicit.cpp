@@ -11,6 +11,12 @@
 //                               iterations, also at N = 32; the defaults solve by CG
 //                               with Jacobi; implicit_cholmod: by CHOLMOD; implicit_fast:
 //                               fastNewton() below)
+//   BM_ProjectiveStep/<global>/N/spinning/threads  projective's step (10 iterations, dt = 0.01)
+//                               as BM_ImplicitIntegratorStep's, on 1 or 2 threads (the pool of
+//                               src/base/parallel.h; run without taskset), its global step by
+//                               the default (spectral: the cosine transform's bound from 16^3
+//                               up) or by the CHOLMOD factor at every N (factor: spectralFrom 0,
+//                               the same-run baseline) (scripts/projective-speed.py)
 //   BM_KeptFactorSolve/<copy|single|cholmod>/N  three right-hand sides solved with projective's
 //                               kept factor M/h^2 + L at N^3 (h = 0.01): our own substitutions
 //                               over the copied factor or over its supernodes in single
@@ -44,6 +50,7 @@
 #include "solvers/system/jacobian.h"
 #include "solvers/system/spring_laplacian.h"
 #include "solvers/system/system_operator.h"
+#include "src/base/parallel.h"
 #include "src/world/scene_builder.h"
 #include "src/world/world_reader.h"
 
@@ -267,6 +274,24 @@ void BM_ImplicitIntegratorStep(benchmark::State& st, IntegratorKind kind,
     if (s.name == "newton_unconverged_steps") st.counters["unconverged"] = s.value;
   }
 }
+void BM_ProjectiveStep(benchmark::State& st, bool factor) {
+  setParallelThreads(static_cast<int>(st.range(2)));
+  SolverOptions options;
+  if (factor) options.projective.spectralFrom = 0;
+  BM_ImplicitIntegratorStep(st, IntegratorKind::Projective, options);
+  st.counters["threads"] = static_cast<double>(st.range(2));
+  setParallelThreads(1);
+}
+BENCHMARK_CAPTURE(BM_ProjectiveStep, spectral, false)
+    ->ArgsProduct({{8, 16, 32}, {0, 1}, {1, 2}})
+    ->ArgNames({"N", "spinning", "threads"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_ProjectiveStep, factor, true)
+    ->ArgsProduct({{8, 16, 32}, {0, 1}, {1, 2}})
+    ->ArgNames({"N", "spinning", "threads"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 // BM_ContactRun (above): a fresh run per iteration, so every iteration meets the same contacts.
 void BM_ContactRun(benchmark::State& st, IntegratorKind kind, ContactModel model,
                    const SolverOptions& options) {

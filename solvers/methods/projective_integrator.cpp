@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "solvers/linalg/prefactored_cholesky.h"
+#include "solvers/system/lattice_spectral.h"
 #include "solvers/system/spring_laplacian.h"
 #include "src/base/assertions.h"
 #include "src/base/interrupt.h"
@@ -75,6 +76,12 @@ void ProjectiveIntegrator::bind(const Model& model) {
   }
   coarse_.reset();
   const int resolution = model.latticeResolution();
+  spectral_.reset();
+  spectralOf_ = {};
+  if (options_.spectralFrom >= 2 && resolution >= options_.spectralFrom &&
+      LatticeSpectral::fits(model)) {
+    spectral_ = std::make_unique<LatticeSpectral>(model);
+  }
   if (options_.coarseNodes >= 2 && resolution >= options_.coarseNodes) {
     coarse_ = std::make_unique<LatticeCoarseSpace>(resolution, options_.coarseNodes);
   }
@@ -179,13 +186,29 @@ bool ProjectiveIntegrator::planWeights(const Model& model, const double* x0, con
   return true;
 }
 
-StepResult ProjectiveIntegrator::factorChanged(double h) {
-  const bool all = !factored_ || h != h_;
-  const double inertia = mass_ / (h * h);
-  if (all && coarse_) {
+StepResult ProjectiveIntegrator::formUnweighted(double inertia) {
+  if (coarse_) {
     // The coarse space's base, whose diagonal a contact's weight is weighed against.
     laplacian_->form(inertia, dampingRate_, 1.0, nullptr, free_);
     coarse_->setBase(free_);
+  }
+  if (spectral_) {
+    // The cosine transform's bound of M/h^2 + L (+ L_c/h): the coordinates without contact
+    // weights in the factor solve with it (ProjectiveOptions::spectralFrom).
+    const auto start = Clock::now();
+    const StepResult formed = spectral_->form(inertia, dampingRate_, 1.0, laplacian_.get());
+    factorSeconds_ += secondsSince(start);
+    ++spectralForms_;
+    if (!formed.ok) return formed.within("projective spectral matrix");
+  }
+  return StepResult::success();
+}
+
+StepResult ProjectiveIntegrator::factorChanged(double h) {
+  const bool all = !factored_ || h != h_;
+  const double inertia = mass_ / (h * h);
+  if (all) {
+    if (StepResult res = formUnweighted(inertia); !res.ok) return res;
   }
   for (int c = 0; c < 3; ++c) {
     // A coordinate whose matrix equals an earlier one's shares its factor.
@@ -200,8 +223,16 @@ StepResult ProjectiveIntegrator::factorChanged(double h) {
       factorOf_[c] = same;
       continue;
     }
-    // Its own factor (kept while it shared another's) still holds or nearly holds its matrix.
-    const bool own = !all && factors_->llt[c].factored();
+    if (spectral_ && weights_[c].isZero(0.0)) {  // no weight: the cosine transform's bound
+      factoredWeights_[c].setZero();
+      factorOf_[c] = c;
+      spectralOf_[c] = true;
+      continue;
+    }
+    // Its own factor (kept while it shared another's) still holds or nearly holds its matrix;
+    // not after the cosine transform served it (its weights are then the transform's: none).
+    const bool own = !all && factors_->llt[c].factored() && !spectralOf_[c];
+    spectralOf_[c] = false;
     if (own && weights_[c] == factoredWeights_[c]) {
       factorOf_[c] = c;
       continue;
@@ -339,13 +370,18 @@ StepResult ProjectiveIntegrator::step(const Model& model, State& s, double h) {
     for (int c = 0; c < 3 && solved.ok;) {  // neighbouring columns with one factor: one solve
       int columns = 1;
       while (c + columns < 3 && factorOf_[c + columns] == factorOf_[c]) ++columns;
-      solved = factors_->llt[factorOf_[c]].solve(delta_.col(c).data(), columns);
+      if (spectralOf_[factorOf_[c]]) {
+        spectral_->solve(delta_.col(c).data(), columns, options_.spectralCorrections);
+      } else {
+        solved = factors_->llt[factorOf_[c]].solve(delta_.col(c).data(), columns);
+      }
       c += columns;
     }
     if (!solved.ok) return solved;
     if (coarse_ && light.load(std::memory_order_relaxed) > 0 && !changed) {
       if (StepResult res = correctOnCoarseNodes(); !res.ok) return res;
     }
+
     solveSeconds_ += secondsSince(start);
     if (options_.chebyshevRho > 0.0) {
       // A new contact set is a new iteration matrix: the Chebyshev run starts again.
@@ -404,6 +440,7 @@ std::vector<Statistic> ProjectiveIntegrator::statistics() const {
       {"barrier_cuts", static_cast<double>(barrierCuts_)},
       {"coarse_corrections", static_cast<double>(coarseCorrections_)},
       {"factor_updates", static_cast<double>(updates_)},
+      {"spectral_forms", static_cast<double>(spectralForms_)},
       {"factor_time_s", factorSeconds_},
       {"chebyshev_restarts", static_cast<double>(chebyshev_.restarts())},
       {"solve_time_s", solveSeconds_},

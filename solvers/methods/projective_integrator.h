@@ -30,8 +30,16 @@
 // alone: each global solve is corrected on 4^3 coarse nodes for the weights the factor lacks or
 // holds stale (solvers/system/lattice_coarse_space.h), which is where a missed contact is stiff
 // (a face pressed against the whole cube's inertia); heavy ones go into the factor as above, and
-// contact_set_changes counts only those. On jello.w at 16^3 one factorization serves the run.
+// contact_set_changes counts only those. On jello.w at 8^3 one factorization serves the run
+// (from 16^3 up, none: below).
 // A coarse factor serves while its weights stay close (LatticeCoarseSpace::correct).
+// From 16^3 up (ProjectiveOptions::spectralFrom), a coordinate with no contact weight in its
+// matrix has no factor at all: its global step solves with the cosine transform's bound
+// P' >= M/h^2 + L (+ L_c/h) of solvers/system/lattice_spectral.h, plus one Neumann correction
+// through the boundary's difference P' - P (ProjectiveOptions::spectralCorrections): O(n log n)
+// a solve and no factorization, and ten iterations as close to backward Euler's step as ten
+// with the factor (tests/projective_spectral_test.cpp). A heavy contact's weight puts its
+// coordinate back on a CHOLMOD factor; light ones stay with the coarse correction.
 // Spring and
 // contact damping, the force field and the user force are evaluated at the iterate (lagged one
 // iteration): at the fixed point they are exactly where backward Euler evaluates them, so the
@@ -60,6 +68,7 @@
 
 namespace jello {
 
+class LatticeSpectral;
 class SpringLaplacian;
 
 class ProjectiveIntegrator final : public Integrator {
@@ -98,6 +107,9 @@ class ProjectiveIntegrator final : public Integrator {
   // The weights for a step from x0 at velocity v0 into weights_; true when they differ from
   // the factored ones (a point about to touch is not covered, or stale weights are dropped).
   bool planWeights(const Model& model, const double* x0, const double* v0, double h);
+  // For a new step size: the coarse space's base and the cosine transform's bound, the matrices
+  // without contact weights (inertia m/h^2).
+  StepResult formUnweighted(double inertia);
   StepResult factorChanged(double h);
 
   ProjectiveOptions options_;
@@ -114,6 +126,11 @@ class ProjectiveIntegrator final : public Integrator {
   std::array<int, 3> factorOf_{{0, 1, 2}};  // which coordinate's factor each one uses
   struct Factors;                           // CHOLMOD's, one per distinct matrix
   std::unique_ptr<Factors> factors_;
+  // The cosine transform's bound of the matrix without contact weights
+  // (ProjectiveOptions::spectralFrom), and which factors it is (by factorOf_'s index).
+  std::unique_ptr<LatticeSpectral> spectral_;
+  std::array<bool, 3> spectralOf_{};
+  long spectralForms_ = 0;
   bool factored_ = false;
   Eigen::VectorXd y_, x_, v_, f_, previous_;  // previous_: the iterate before x_; v_: (x_ - x0)/h
   Eigen::VectorXd ahead_;                     // planWeights' positions

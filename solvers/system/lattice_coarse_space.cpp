@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "src/base/assertions.h"
+#include "src/base/parallel.h"
 #include "src/world/lattice.h"
 
 namespace jello {
@@ -128,13 +129,24 @@ StepResult LatticeCoarseSpace::correct(const Eigen::VectorXd& w, const double* d
 }
 
 void LatticeCoarseSpace::prolong(const double* c, double* x) const {
-  for (int p = 0; p < n_; ++p) {
-    const int* np = &node_[8 * std::size_t(p)];
-    const double* wp = &weight_[8 * std::size_t(p)];
-    double sum = 0.0;
-    for (int a = 0; a < 8; ++a) sum += wp[a] * c[np[a]];
-    x[p] += sum;
+  auto range = [&](std::ptrdiff_t lo, std::ptrdiff_t hi) {
+    for (std::ptrdiff_t p = lo; p < hi; ++p) {
+      const int* np = &node_[8 * std::size_t(p)];
+      const double* wp = &weight_[8 * std::size_t(p)];
+      double sum = 0.0;
+      for (int a = 0; a < 8; ++a) sum += wp[a] * c[np[a]];
+      x[p] += sum;
+    }
+  };
+  // Eight gathers a point: at 32^3 a third of a millisecond a coordinate on one thread.
+  const int threads = threadsFor(n_);
+  if (threads <= 1) {
+    range(0, n_);
+    return;
   }
+  runParallel(threads, [&](int t) {
+    range(n_ * std::ptrdiff_t(t) / threads, n_ * std::ptrdiff_t(t + 1) / threads);
+  });
 }
 
 }  // namespace jello
