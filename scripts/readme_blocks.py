@@ -16,6 +16,7 @@ BLOCKS = {
     "ci-time": "README.md",
     "contact-newton": "README.md",
     "contact-speed": "README.md",
+    "projective-speed": "README.md",
     "experiments-runtime": "experiments/README.md",
     "stability-summary": "experiments/README.md",
     "work-precision-summary": "experiments/README.md",

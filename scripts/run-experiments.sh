@@ -10,9 +10,12 @@
 # resumes from its last saved state, and the committed reference is reused, so that a rerun
 # only times the integrators; and redraws the atlas charts.
 # `scripts/run-experiments.sh atlas-free` runs the atlas's second scene (the same throw and spin
-# without gravity: no contact) at N = 8, then at N = 16 for k = 1e5, 1e6, 1e7 (a 60 s budget),
-# one point at a time on one core (two at a time moved projective's figures by up to 40%), into
-# experiments/results/atlas_free/, and draws its charts (about 10 and 40 minutes on a 2-core VM).
+# without gravity: no contact) at N = 8, then at N = 16 for k = 1e5, 1e6, 1e7, then at N = 32 for
+# k = 1e2 to 1e6 (a 60 s budget from 16 up), one point at a time on one core (two at a time moved
+# projective's figures by up to 40%; N = 32's references on both cores), into
+# experiments/results/atlas_free/, and draws its charts (about 10, 40 and 60 minutes on a 2-core
+# VM; at N = 32, k = 1e7 and 1e8 the RK4 reference alone takes hours); FREE_N=8, 16 or 32 runs
+# one of them.
 # `scripts/run-experiments.sh atlas-contact` runs the falling scene's atlas at N = 8 with the floor
 # as stiff as the springs, 20 times stiffer and as the log barrier (--atlas-contact k, 20k,
 # barrier), one point at a time, into experiments/results/atlas_contact_k/, atlas_contact_20k/
@@ -112,7 +115,9 @@ draw_atlas() {
   gnuplot -e "dir='$out'; atlas_ns='$ns'" experiments/plots/scaling.gp
 }
 draw_free_atlas() {
-  gnuplot -e "dir='$out/atlas_free'; atlas_ns='8 16'; atlas_only=1; scene=' (free flight)'" \
+  local ns="8 16"
+  if [ -f "$out/atlas_free/atlas32_atlas.csv" ]; then ns="8 16 32"; fi
+  gnuplot -e "dir='$out/atlas_free'; atlas_ns='$ns'; atlas_only=1; scene=' (free flight)'" \
     experiments/plots/scaling.gp
 }
 # The stiffer floors' atlases, those that have run.
@@ -201,10 +206,21 @@ if [ "${1:-}" = atlas-free ]; then
     "${launch[@]}" "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 16 \
       --atlas-k 1e5,1e6,1e7 --atlas-budget 60 --jobs 1 --name atlas16 --quiet --out-dir "$free"
   else
-    taskset -c 1 "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 8 --jobs 1 \
-      --out-dir "$free"
-    taskset -c 1 "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 16 \
-      --atlas-k 1e5,1e6,1e7 --atlas-budget 60 --jobs 1 --name atlas16 --out-dir "$free"
+    if [ -z "${FREE_N:-}" ] || [ "$FREE_N" = 8 ]; then
+      taskset -c 1 "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 8 --jobs 1 \
+        --out-dir "$free"
+    fi
+    if [ -z "${FREE_N:-}" ] || [ "$FREE_N" = 16 ]; then
+      taskset -c 1 "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 16 \
+        --atlas-k 1e5,1e6,1e7 --atlas-budget 60 --jobs 1 --name atlas16 --out-dir "$free"
+    fi
+    if [ -z "${FREE_N:-}" ] || [ "$FREE_N" = 32 ]; then
+      # The runs on one thread of either core (no taskset: the references use both), and the
+      # references, minutes of RK4 each, on both.
+      JELLO_THREADS=1 "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 32 \
+        --atlas-k 1e2,1e3,1e4,1e5,1e6 --atlas-budget 60 --jobs 1 --atlas-reference-threads 2 \
+        --atlas-references "$free/atlas_references" --name atlas32 --out-dir "$free"
+    fi
   fi
   draw_free_atlas
   echo "run-experiments: the free scene's atlas in $free/"
