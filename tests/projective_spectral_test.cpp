@@ -13,6 +13,7 @@
 #include "solvers/methods/projective_integrator.h"
 #include "solvers/system/lattice_spectral.h"
 #include "solvers/system/spring_laplacian.h"
+#include "src/base/parallel.h"
 #include "src/world/scene_builder.h"
 #include "tests/test_support.h"
 
@@ -83,6 +84,27 @@ TEST(LatticeSpectral, FitsOnlyTheWholeLatticeWithOneStiffnessPerKind) {
   ModelSpec loose = modelSpecFromWorld(w);
   loose.latticeResolution = 0;  // points that are not a lattice's
   EXPECT_FALSE(LatticeSpectral::fits(Model(loose)));
+}
+
+// A run repeats to the bit: the same plans in every solver, and the same arithmetic on one
+// thread as on two (16^3 is split over the threads).
+TEST(LatticeSpectral, SolvesTheSameBitsOnOneAndTwoThreadsAndInEverySolver) {
+  const Model model(spinningCubeAt(16, 0.0));
+  const SpringLaplacian laplacian(model);
+  const Eigen::MatrixXd r = Eigen::MatrixXd::Random(model.numPoints(), 3);
+  Eigen::MatrixXd x[3];
+  const int threads = parallelThreads();
+  for (int i = 0; i < 3; ++i) {
+    setParallelThreads(i == 0 ? 1 : 2);
+    LatticeSpectral spectral(model);
+    ASSERT_TRUE(spectral.form(model.mass() / 1e-4, 0.0, 1.0, &laplacian).ok);
+    x[i] = r;
+    spectral.solve(x[i].data(), 3, 1);
+  }
+  setParallelThreads(threads);
+  EXPECT_TRUE(x[0] == x[1]);
+  EXPECT_TRUE(x[1] == x[2]);
+  EXPECT_FALSE(x[0] == r);
 }
 
 TEST(LatticeSpectral, RefusesABoundThatIsNotPositiveDefinite) {

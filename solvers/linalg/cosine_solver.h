@@ -2,7 +2,9 @@
 // axis of an N x N x N grid, flat index (i N + j) N + k) diagonalizes: S = Q diag(lambda) Q',
 // Q's columns cos(pi a (i + 1/2)/N) cos(pi b (j + 1/2)/N) cos(pi c (k + 1/2)/N) normalized.
 // A solve is a forward transform, a division by the eigenvalues and the inverse transform:
-// O(n log n) with no factor, by FFTW's real-to-real transforms (REDFT10 and its inverse REDFT01).
+// O(n log n) with no factor, by FFTW's real-to-real transforms (REDFT10 and its inverse REDFT01),
+// planned the same way in every process and split over threads by whole slabs and lines, so a
+// solve gives the same bits every run and on any number of threads.
 // The graph Laplacian of a path of N points (free ends) has this basis, with the eigenvalues
 // 2 - 2 cos(pi a/N); solvers/system/lattice_spectral.h builds the lattice's operators on it.
 #pragma once

@@ -111,35 +111,43 @@ StepResult LatticeSpectral::form(double d, double a, double b, const SpringLapla
 
 void LatticeSpectral::solve(double* x, int columns, int corrections) {
   const std::ptrdiff_t size = numPoints();
-  Eigen::Map<Eigen::MatrixXd> X(x, size, columns);
   solver_.solve(x, columns);
   if (corrections <= 0) return;
-  first_ = X;
+  first_.resize(size, columns);
   work_.resize(size, columns);
-  // (P' - P) X by rows, split over the threads: P' - P is symmetric, so row p is column p.
   const int* outer = boundary_.outerIndexPtr();
   const int* inner = boundary_.innerIndexPtr();
   const double* value = boundary_.valuePtr();
-  auto product = [&](std::ptrdiff_t lo, std::ptrdiff_t hi) {
-    for (int c = 0; c < columns; ++c) {
-      const double* xc = X.col(c).data();
-      double* out = work_.col(c).data();
-      for (std::ptrdiff_t p = lo; p < hi; ++p) {
-        double sum = 0.0;
-        for (int i = outer[p]; i < outer[p + 1]; ++i) sum += value[i] * xc[inner[i]];
-        out[p] = sum;
-      }
-    }
-  };
+  // Over the points, split over the threads: each pass touches only its own rows.
   const int threads = threadsFor(size);
-  for (int c = 0; c < corrections; ++c) {
-    if (threads <= 1) {
-      product(0, size);
-    } else {
-      runParallel(threads, [&](int t) { product(size * t / threads, size * (t + 1) / threads); });
-    }
+  auto rows = [&](const auto& body) {
+    if (threads <= 1) return body(std::ptrdiff_t(0), size);
+    runParallel(threads, [&](int t) { body(size * t / threads, size * (t + 1) / threads); });
+  };
+  for (int correction = 0; correction < corrections; ++correction) {
+    // work = (P' - P) x by rows (symmetric: row p is column p), x kept as x0 on the first.
+    rows([&](std::ptrdiff_t lo, std::ptrdiff_t hi) {
+      for (int c = 0; c < columns; ++c) {
+        const double* xc = x + c * size;
+        double* out = work_.col(c).data();
+        double* keep = first_.col(c).data();
+        for (std::ptrdiff_t p = lo; p < hi; ++p) {
+          double sum = 0.0;
+          for (int i = outer[p]; i < outer[p + 1]; ++i) sum += value[i] * xc[inner[i]];
+          out[p] = sum;
+          if (correction == 0) keep[p] = xc[p];
+        }
+      }
+    });
     solver_.solve(work_.data(), columns);
-    X = first_ + work_;
+    rows([&](std::ptrdiff_t lo, std::ptrdiff_t hi) {  // x = x0 + P'^-1 (P' - P) x
+      for (int c = 0; c < columns; ++c) {
+        const double* keep = first_.col(c).data();
+        const double* w = work_.col(c).data();
+        double* xc = x + c * size;
+        for (std::ptrdiff_t p = lo; p < hi; ++p) xc[p] = keep[p] + w[p];
+      }
+    });
   }
 }
 
