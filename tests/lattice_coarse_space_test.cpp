@@ -25,14 +25,18 @@ SparseMatrix projectiveMatrix(int resolution) {
   return S;
 }
 
-TEST(LatticeCoarseSpace, InterpolatesLinearFieldsExactly) {
+TEST(LatticeCoarseSpace, InterpolatesTrilinearFieldsExactly) {
   const int resolution = 7, nodes = 3;
   const LatticeCoarseSpace space(resolution, nodes);
   ASSERT_EQ(space.size(), 27);
   // f(i, j, k) = 1 + 2 i - 3 j + 0.5 k in lattice index units, at the coarse nodes (a node a
   // spans (resolution - 1) / (nodes - 1) points).
   const double span = double(resolution - 1) / (nodes - 1);
-  const auto f = [](double i, double j, double k) { return 1.0 + 2.0 * i - 3.0 * j + 0.5 * k; };
+  // Linear in each index, with products: trilinear interpolation reproduces it in every cell,
+  // and a mix-up of the axes would not.
+  const auto f = [](double i, double j, double k) {
+    return 1.0 + 2.0 * i - 3.0 * j + 0.5 * k + 0.25 * i * j - 0.125 * j * k + 0.0625 * i * j * k;
+  };
   Eigen::VectorXd coarse(27);
   for (int a = 0; a < nodes; ++a)
     for (int b = 0; b < nodes; ++b)

@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "src/base/assertions.h"
-#include "src/base/parallel.h"
 #include "src/world/lattice.h"
 
 namespace jello {
@@ -15,11 +14,13 @@ namespace {
 bool serves(const Eigen::VectorXd& factored, const Eigen::VectorXd& wanted) {
   if (factored.size() != wanted.size()) return false;
   const Eigen::Index n = wanted.size();
+  const double *f = factored.data(), *w = wanted.data();
+  long far = 0;  // counted without a branch: the loop vectorizes (a scan of every point)
+#pragma omp simd reduction(+ : far)
   for (Eigen::Index p = 0; p < n; ++p) {
-    const double a = factored[p], b = wanted[p];
-    if (std::abs(a - b) > 0.25 * std::max(a, b)) return false;  // and 0 against > 0
+    far += long(std::abs(f[p] - w[p]) > 0.25 * std::max(f[p], w[p]));  // and 0 against > 0
   }
-  return true;
+  return far == 0;
 }
 
 }  // namespace
@@ -33,8 +34,12 @@ LatticeCoarseSpace::LatticeCoarseSpace(int resolution, int nodes) {
   weight_.resize(8 * std::size_t(n_));
   // Each lattice index's coarse cell and its place in it.
   const double scale = double(nodes - 1) / (resolution - 1);
-  std::vector<int> cell(resolution);
-  std::vector<double> place(resolution);
+  resolution_ = resolution;
+  nodes_ = nodes;
+  std::vector<int>& cell = cell_;
+  std::vector<double>& place = place_;
+  cell.resize(std::size_t(resolution));
+  place.resize(std::size_t(resolution));
   for (int i = 0; i < resolution; ++i) {
     const double t = i * scale;
     cell[i] = std::min(static_cast<int>(t), nodes - 2);
@@ -129,24 +134,37 @@ StepResult LatticeCoarseSpace::correct(const Eigen::VectorXd& w, const double* d
 }
 
 void LatticeCoarseSpace::prolong(const double* c, double* x) const {
-  auto range = [&](std::ptrdiff_t lo, std::ptrdiff_t hi) {
-    for (std::ptrdiff_t p = lo; p < hi; ++p) {
-      const int* np = &node_[8 * std::size_t(p)];
-      const double* wp = &weight_[8 * std::size_t(p)];
-      double sum = 0.0;
-      for (int a = 0; a < 8; ++a) sum += wp[a] * c[np[a]];
-      x[p] += sum;
+  // P is the product of one hat-function matrix per axis (P1 (x) P1 (x) P1, each fine index on
+  // its cell's two nodes), so x += P c is three one-axis passes, k, j, then i, of two
+  // multiply-adds a value: at 32^3 a thirtieth of the eight gathers a point of the rows of P.
+  const std::ptrdiff_t N = resolution_, g = nodes_;
+  along_k_.assign(std::size_t(g * g * N), 0.0);  // [a][b][k]
+  along_j_.assign(std::size_t(g * N * N), 0.0);  // [a][j][k]
+  for (std::ptrdiff_t ab = 0; ab < g * g; ++ab) {
+    for (std::ptrdiff_t k = 0; k < N; ++k) {
+      const double* from = c + ab * g + cell_[std::size_t(k)];
+      const double t = place_[std::size_t(k)];
+      along_k_[std::size_t(ab * N + k)] = (1.0 - t) * from[0] + t * from[1];
     }
-  };
-  // Eight gathers a point: at 32^3 a third of a millisecond a coordinate on one thread.
-  const int threads = threadsFor(n_);
-  if (threads <= 1) {
-    range(0, n_);
-    return;
   }
-  runParallel(threads, [&](int t) {
-    range(n_ * std::ptrdiff_t(t) / threads, n_ * std::ptrdiff_t(t + 1) / threads);
-  });
+  for (std::ptrdiff_t a = 0; a < g; ++a) {
+    for (std::ptrdiff_t j = 0; j < N; ++j) {
+      const double* b0 = &along_k_[std::size_t((a * g + cell_[std::size_t(j)]) * N)];
+      const double* b1 = b0 + N;
+      const double t = place_[std::size_t(j)];
+      double* out = &along_j_[std::size_t((a * N + j) * N)];
+#pragma omp simd
+      for (std::ptrdiff_t k = 0; k < N; ++k) out[k] = (1.0 - t) * b0[k] + t * b1[k];
+    }
+  }
+  for (std::ptrdiff_t i = 0; i < N; ++i) {
+    const double* a0 = &along_j_[std::size_t(cell_[std::size_t(i)] * N * N)];
+    const double* a1 = a0 + N * N;
+    const double t = place_[std::size_t(i)];
+    double* out = x + i * N * N;
+#pragma omp simd
+    for (std::ptrdiff_t jk = 0; jk < N * N; ++jk) out[jk] += (1.0 - t) * a0[jk] + t * a1[jk];
+  }
 }
 
 }  // namespace jello

@@ -63,8 +63,11 @@ class LatticeCoarseSpace {
   // A kept factor that serves w, or a new one in the oldest slot.
   StepResult factorFor(const Eigen::VectorXd& w, const Factor** out);
 
-  int n_;
-  std::vector<int> node_;          // n x 8: each point's coarse nodes
+  int n_, resolution_, nodes_;
+  std::vector<int> cell_;      // per lattice index along an axis: its coarse cell
+  std::vector<double> place_;  // and its place in it, 0 to 1
+  mutable std::vector<double> along_k_, along_j_;  // prolong's passes
+  std::vector<int> node_;                          // n x 8: each point's coarse nodes
   std::vector<double> weight_;     // n x 8: their hat functions' values at the point
   Eigen::MatrixXd base_, work_;    // B, and B + P' diag(w) P
   Eigen::VectorXd diagonal_;       // S's
