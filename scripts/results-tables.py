@@ -539,6 +539,19 @@ def atlas_pays(subdirectory=""):
     return pays
 
 
+def atlas_alone(subdirectory=""):
+    """(N, k, integrator) wherever no explicit method kept the visible motion within the budget
+    and another did (the cheapest of those), in order of N and k."""
+    alone = []
+    for n, (rows, _) in sorted(atlas_sources(subdirectory).items()):
+        for k in sorted({float(r["k_N_per_m"]) for r in rows}):
+            here = [r for r in rows if float(r["k_N_per_m"]) == k]
+            o = atlas_cheapest(here, False)
+            if o and not atlas_cheapest(here, True):
+                alone.append((n, k, o["integrator"]))
+    return alone
+
+
 def atlas_summary(subdirectory=""):
     by_n = atlas_sources(subdirectory)
     first = next(iter(by_n.values()))[1][0]["parameters"]["atlas"]
@@ -592,14 +605,7 @@ def atlas_summary(subdirectory=""):
         lines.append("Where an implicit or adaptive method is cheapest: " + "; ".join(
             f"N = {n}, k = {k_text(k)}: {name}, {x:.2g}x faster than the cheapest explicit method"
             for n, k, name, x in pays) + ".")
-    # Where no explicit method kept the motion within the budget and another did.
-    alone = []
-    for n, (rows, _) in sorted(by_n.items()):
-        for k in sorted({float(r["k_N_per_m"]) for r in rows}):
-            here = [r for r in rows if float(r["k_N_per_m"]) == k]
-            o = atlas_cheapest(here, False)
-            if o and not atlas_cheapest(here, True):
-                alone.append(f"N = {n}, k = {k_text(k)}: {o['integrator']}")
+    alone = [f"N = {n}, k = {k_text(k)}: {name}" for n, k, name in atlas_alone(subdirectory)]
     if alone:
         lines.append("Where no explicit method keeps it within the budget and another does: "
                      + "; ".join(alone) + ".")
@@ -671,14 +677,15 @@ def experiments_runtime():
                      f"{t:.0f} min{r}" for _, _, t, r in extra) +
                  (", the timed runs" if any(r for *_, r in extra) else ",") +
                  " each on one core of the same machine.")
-    free = sorted((n, sidecar["wall_time_s"], sidecar["parameters"]["jobs"])
+    free = sorted((n, sidecar["wall_time_s"], sidecar["parameters"]["jobs"],
+                   reference_note(sidecar))
                   for n, (_, sidecars) in atlas_sources(ATLAS_FREE).items()
                   for sidecar in sidecars)
     if free:
-        text += (" The free scene's atlas at " + " and ".join(f"N = {n}" for n, _, _ in free) +
+        text += (" The free scene's atlas at " + " and ".join(f"N = {n}" for n, *_ in free) +
                  " took " + " and ".join(
-                     f"{t / 60:.0f} min on {'one core' if j == 1 else f'{j} cores'}"
-                     for _, t, j in free) + ".")
+                     f"{t / 60:.0f} min on {'one core' if j == 1 else f'{j} cores'}{note}"
+                     for _, t, j, note in free) + ".")
     return text
 
 
@@ -764,7 +771,14 @@ def findings():
     free8 = [p for p in free if p[0] == min(q[0] for q in free)]
     third = (f"**Where implicit integration pays**: in free flight from k = {k_text(free8[0][1])} "
              f"at N = {free8[0][0]} ({free8[0][2]}, {free8[0][3]:.2g}x faster than the cheapest "
-             f"explicit method; {free8[-1][3]:.2g}x at k = {k_text(free8[-1][1])}); once the cube "
+             f"explicit method; {free8[-1][3]:.2g}x at k = {k_text(free8[-1][1])})"
+             + "".join(f"; at N = {n} at " + ", ".join(
+                 f"k = {k_text(k)} ({name}, {x:.2g}x)" for m, k, name, x in free if m == n)
+                 for n in sorted({p[0] for p in free} - {free8[0][0]}))
+             + "".join(f"; at N = {n}, k = {k_text(k)} no explicit method keeps it within the "
+                       f"budget and {name} does"
+                       for n, k, name in atlas_alone(ATLAS_FREE))
+             + "; once the cube "
              "falls onto the course's soft floor (400 N/m), " +
              ("only at " + "; ".join(f"N = {n}, k = {k_text(k)} ({name}, {x:.2g}x)"
                                     for n, k, name, x in falling) if falling else "nowhere") +
