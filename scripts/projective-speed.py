@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Projective's step on both cores: the cosine-transform global step against the CHOLMOD factor.
 
-    scripts/projective-speed.py [--run]
+    scripts/projective-speed.py [--run] [--baseline BENCHMARKS]
 
 --run runs BM_ProjectiveStep (experiments/bench/benchmarks_implicit.cpp: one step of jello.w, or
 of the spinning stiff cube, at dt = 0.01 s with 10 iterations, after a first step timed apart; on
@@ -10,6 +10,13 @@ every size, spectralFrom = 0, the same-run baseline) on the native build without
 repetitions, and writes Google Benchmark's JSON with the commit measured to
 experiments/results/projective_speed.json (about three minutes). Without it, prints the README's
 table (block projective-speed, which scripts/results-tables.py writes from that file alone).
+
+--baseline BENCHMARKS takes a benchmarks binary built from an earlier commit (a git worktree's
+build/native/bin/benchmarks) and runs, alternately with this checkout's, the benchmarks both
+have at 8^3 and 16^3: BM_ContactRun/projective/penalty (jello.w's first 30 steps) and
+BM_ImplicitIntegratorStep/projective on the spinning cube, three repetitions each, on both
+cores, into experiments/results/projective_baseline.json (the steps before and after a change,
+in one run).
 """
 import argparse
 import json
@@ -37,6 +44,59 @@ def run():
     with open(tmp, "w") as f:
         json.dump(data, f, indent=2)
     os.replace(tmp, JSON)
+
+
+BASELINE_JSON = os.path.join(ROOT, "experiments", "results", "projective_baseline.json")
+BASELINE_FILTER = ("BM_ContactRun/projective/penalty/N:(8|16)/|"
+                   "BM_ImplicitIntegratorStep/projective/N:(8|16)/spinning:1")
+
+
+def commit_of(directory):
+    return subprocess.run(["git", "rev-parse", "HEAD"], cwd=directory, capture_output=True,
+                          text=True, check=True).stdout.strip()
+
+
+def run_baseline(binary):
+    """Medians (ms) of BASELINE_FILTER by the baseline binary and this checkout's, alternately."""
+    out = {"baseline_commit": commit_of(os.path.dirname(os.path.abspath(binary))),
+           "commit": commit_of(ROOT), "benchmarks": {}}
+    for round_ in range(3):
+        for which, path in (("baseline", binary), ("now", BINARY)):
+            tmp = BASELINE_JSON + f".{which}.tmp"
+            subprocess.run([path, "--benchmark_filter=" + BASELINE_FILTER,
+                            "--benchmark_out=" + tmp, "--benchmark_out_format=json"], check=True)
+            with open(tmp) as f:
+                data = json.load(f)
+            os.remove(tmp)
+            for b in data["benchmarks"]:
+                ms = b["real_time"] * {"us": 1e-3, "ms": 1.0, "s": 1e3}[b["time_unit"]]
+                out["benchmarks"].setdefault(b["name"], {}).setdefault(which, []).append(ms)
+            out["date"] = data["context"]["date"]
+    tmp = BASELINE_JSON + ".tmp"
+    with open(tmp, "w") as f:
+        json.dump(out, f, indent=2)
+    os.replace(tmp, BASELINE_JSON)
+
+
+def baseline_text():
+    """The README's sentence on the steps before and after, from projective_baseline.json."""
+    if not os.path.exists(BASELINE_JSON):
+        return ""
+    with open(BASELINE_JSON) as f:
+        data = json.load(f)
+    parts = []
+    for name, runs in data["benchmarks"].items():
+        def median_and_range(values):
+            v = sorted(values)
+            return f"{v[len(v) // 2]:.3g} ms ({v[0]:.3g}-{v[-1]:.3g})"
+        n = name.split("N:")[1].split("/")[0]
+        scene = "jello.w's first 30 steps" if name.startswith("BM_ContactRun") else "the spinning cube"
+        parts.append(f"{n}^3, {scene}: {median_and_range(runs['baseline'])} before, "
+                     f"{median_and_range(runs['now'])} after")
+    return (f" Against the code before the cosine bound (commit {data['baseline_commit'][:7]}), "
+            f"alternately in one run on both cores (medians of 3, their range in brackets; "
+            f"`--baseline`, experiments/results/projective_baseline.json), a step at "
+            + "; ".join(parts) + ".")
 
 
 def medians(data):
@@ -85,18 +145,24 @@ def table(path=JSON):
                  f"(`scripts/projective-speed.py --run`, the native build, "
                  f"{ctx['num_cpus']} CPUs, {ctx['date'][:10]}, commit "
                  f"{ctx['jello_commit'][:7]}; experiments/results/projective_speed.json). At 32^3 "
-                 f"on both cores the slower scene's step takes {ms(worst)}.")
+                 f"on both cores the slower scene's step takes {ms(worst)}." + baseline_text())
     return "\n".join(lines)
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--run", action="store_true", help="measure again (about three minutes)")
+    parser.add_argument("--baseline", metavar="BENCHMARKS",
+                        help="an earlier commit's benchmarks binary: before and after, alternately")
     args = parser.parse_args()
+    if (args.run or args.baseline) and not os.path.exists(BINARY):
+        sys.exit(f"projective-speed: no {BINARY}: build the native preset first")
+    if args.baseline and not os.access(args.baseline, os.X_OK):
+        sys.exit(f"projective-speed: --baseline {args.baseline}: not an executable")
     if args.run:
-        if not os.path.exists(BINARY):
-            sys.exit(f"projective-speed: no {BINARY}: build the native preset first")
         run()
+    if args.baseline:
+        run_baseline(args.baseline)
     print(table())
 
 

@@ -32,7 +32,7 @@ std::mutex& plannerMutex() {
 // run repeats to the bit (FFTW_MEASURE times candidates and may pick another plan, with other
 // rounding, run to run); on contiguous data they are what FFTW_MEASURE picks (r2cf codelets), and
 // the gather does the buffering FFTW_MEASURE chose for the strided lines (a solve of three 32^3
-// columns on one core: 1.3 ms either way, against 2.3 ms for FFTW_ESTIMATE on strided lines).
+// columns on one core, measured apart: 1.3 ms either way, 2.3 ms with ESTIMATE on strided lines).
 struct CosineSolver::Plans {
   fftw_plan slab = nullptr, slabInverse = nullptr;    // one slab, n x n contiguous
   fftw_plan lines = nullptr, linesInverse = nullptr;  // n contiguous lines of n
