@@ -30,12 +30,16 @@ BINARY = os.path.join(ROOT, "build", "native", "bin", "benchmarks")
 SCENES = {"0": "jello.w", "1": "spinning cube"}
 
 
+def commit_of(directory):
+    return subprocess.run(["git", "rev-parse", "HEAD"], cwd=directory, capture_output=True,
+                          text=True, check=True).stdout.strip()
+
+
 def run():
     tmp = JSON + ".tmp"
     subprocess.run([BINARY, "--benchmark_filter=BM_ProjectiveStep", "--benchmark_repetitions=3",
                     "--benchmark_out=" + tmp, "--benchmark_out_format=json"], check=True)
-    commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True,
-                            text=True, check=True).stdout.strip()
+    commit = commit_of(ROOT)
     dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT,
                            capture_output=True, text=True, check=True).stdout.strip()
     with open(tmp) as f:
@@ -49,11 +53,6 @@ def run():
 BASELINE_JSON = os.path.join(ROOT, "experiments", "results", "projective_baseline.json")
 BASELINE_FILTER = ("BM_ContactRun/projective/penalty/N:(8|16)/|"
                    "BM_ImplicitIntegratorStep/projective/N:(8|16)/spinning:1")
-
-
-def commit_of(directory):
-    return subprocess.run(["git", "rev-parse", "HEAD"], cwd=directory, capture_output=True,
-                          text=True, check=True).stdout.strip()
 
 
 def run_baseline(binary):

@@ -60,4 +60,18 @@ inline Eigen::Vector3d angularMomentum(const Model& model, const State& s) {
   return L;
 }
 
+// The backward-Euler step from `start` solved tightly (Newton to 1e-12, positions to 1e-14): the
+// reference projective's iterations must approach. Fails the test if Newton does not converge.
+inline State backwardEulerStep(const Model& model, const State& start, double h) {
+  ImplicitOptions o;
+  o.newtonTolerance = 1e-12;
+  o.newtonPositionTolerance = 1e-14;
+  o.newtonMaxIterations = 200;
+  BackwardEuler be(o);
+  State s = start;
+  EXPECT_TRUE(be.step(model, s, h).ok);
+  EXPECT_TRUE(be.lastConverged());
+  return s;
+}
+
 }  // namespace jello::test

@@ -16,6 +16,7 @@
 #include "solvers/system/spring_laplacian.h"
 #include "src/base/parallel.h"
 #include "src/world/scene_builder.h"
+#include "tests/newton_test_support.h"
 #include "tests/test_support.h"
 
 namespace jello {
@@ -66,6 +67,7 @@ TEST(LatticeSpectral, BoundsTheLaplacianFromAboveAndEqualsItInside) {
     const Eigen::VectorXd ratio = Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd>(
                                       P, 0.5 * (bound + bound.transpose()))
                                       .eigenvalues();
+    // Shown for solvers/README.md's figure; asserted below.
     std::printf("N = %d: P'^-1 P in [%.3f, %.3f]\n", resolution, ratio.minCoeff(),
                 ratio.maxCoeff());
     EXPECT_GT(ratio.minCoeff(), resolution >= 5 ? 0.3 : 0.25);
@@ -131,6 +133,7 @@ TEST(LatticeSpectral, CorrectionsConvergeToTheExactMatrixsSolve) {
     Eigen::MatrixXd x = r;
     spectral.solve(x.data(), 3, corrections);
     const double residual = (P * x - r).norm() / r.norm();
+    // Shown for the contraction; asserted on the next line.
     std::printf("%2d corrections: relative residual %.3g\n", corrections, residual);
     EXPECT_LT(residual, corrections == 0 ? 1.0 : 0.7 * previous);
     previous = residual;
@@ -167,17 +170,11 @@ TEST(LatticeSpectral, ProjectiveConvergesToTheBackwardEulerStepAsWithTheFactor) 
     const World w = spinningCubeAt(resolution, 0.0);
     const Model model(w);
     const State start = initialState(w);
-    ImplicitOptions io;
-    io.newtonTolerance = 1e-12;
-    io.newtonPositionTolerance = 1e-14;
-    io.newtonMaxIterations = 200;
-    BackwardEuler be(io);
-    State end = start;
-    ASSERT_TRUE(be.step(model, end, 0.01).ok);
-    ASSERT_TRUE(be.lastConverged());
+    const State end = test::backwardEulerStep(model, start, 0.01);
     for (int iterations : {10, 20}) {
       const double factor = stepError(model, start, end, iterations, 0);
       const double spectral = stepError(model, start, end, iterations, 2);
+      // Shown for solvers/README.md's figures; asserted on the next line.
       std::printf("%d^3, %d iterations: within %.3g of backward Euler's step (factor: %.3g)\n",
                   resolution, iterations, spectral, factor);
       EXPECT_LE(spectral, factor) << resolution << "^3, " << iterations << " iterations";
@@ -205,14 +202,7 @@ TEST(LatticeSpectral, ReachesTheBackwardEulerStepThroughLightAndHeavyContact) {
     for (int p = 0; p < n; ++p) start.x[p] -= through;
     start.v.setZero();  // its own velocity would carry it off the wall within the step
     for (int p = 0; p < n; ++p) start.v[2 * n + p] = -3.0;
-    ImplicitOptions io;
-    io.newtonTolerance = 1e-12;
-    io.newtonPositionTolerance = 1e-14;
-    io.newtonMaxIterations = 200;
-    BackwardEuler be(io);
-    State end = start;
-    ASSERT_TRUE(be.step(model, end, 0.01).ok);
-    ASSERT_TRUE(be.lastConverged());
+    const State end = test::backwardEulerStep(model, start, 0.01);
     ProjectiveOptions o;
     o.iterations = 300;
     o.spectralFrom = 2;

@@ -19,19 +19,7 @@ namespace jello {
 namespace {
 
 using test::angularMomentum;
-
-// The backward-Euler step solved tightly: the reference the iterations must approach.
-State backwardEulerStep(const Model& model, const State& start, double h) {
-  ImplicitOptions o;
-  o.newtonTolerance = 1e-12;
-  o.newtonPositionTolerance = 1e-14;
-  o.newtonMaxIterations = 200;
-  BackwardEuler be(o);
-  State s = start;
-  EXPECT_TRUE(be.step(model, s, h).ok);
-  EXPECT_TRUE(be.lastConverged());
-  return s;
-}
+using test::backwardEulerStep;
 
 State projectiveStep(const Model& model, const State& start, double h, int iterations,
                      double chebyshevRho = 0.0, ProjectiveOptions o = {}) {
