@@ -3,12 +3,12 @@
 # JSON sidecars, PNG and SVG): the README's Results section gives their run time (generated
 # from the sidecars). `scripts/run-experiments.sh quick`
 # runs the --quick grids instead (under a minute), into build/experiments-quick/.
-# `scripts/run-experiments.sh atlas` runs the crossover atlas at N = 16 (k = 1e2..1e8) and N = 32
-# (k = 1e2..1e6, then 1e7 in a run of its own) instead, side by side, one core each (about two
-# hours on a 2-core VM), then N = 32 at k = 1e8, whose RK4 reference (2.5 million steps of 32^3,
-# over an hour on both cores) is kept in experiments/results/atlas_references/: a stopped run
-# resumes from its last saved state, and the committed reference is reused, so that a rerun
-# only times the integrators; and redraws the atlas charts.
+# `scripts/run-experiments.sh atlas` runs the crossover atlas at N = 16 (k = 1e2..1e8), then at
+# N = 32 (k = 1e2..1e6, 1e7 and 1e8 in runs of their own) instead, one point at a time on one
+# core; the RK4 references on both cores, kept in experiments/results/atlas_references/ (N = 32
+# at k = 1e8: 2.5 million steps of 32^3, over an hour): a stopped reference resumes from its last
+# saved state, and a committed one is reused, so that a rerun only times the integrators; then it
+# redraws the atlas charts. FALL_N=16 or 32 runs one N.
 # `scripts/run-experiments.sh atlas-free` runs the atlas's second scene (the same throw and spin
 # without gravity: no contact) at N = 8, then at N = 16 for k = 1e5, 1e6, 1e7, then at N = 32 for
 # k = 1e2 to 1e6 (a 60 s budget from 16 up), one point at a time on one core (two at a time moved
@@ -180,17 +180,20 @@ if [ "${1:-}" = atlas ]; then
     echo "run-experiments: the atlas at N = 16 and 32 in $out/ ($ranks ranks)"
     exit 0
   fi
-  taskset -c 0 "$bin/jello-scaling" "${common[@]}" --atlas-n 16 --name atlas16 &
-  first=$!
-  taskset -c 1 "$bin/jello-scaling" "${common[@]}" --atlas-n 32 \
-    --atlas-k 1e2,1e3,1e4,1e5,1e6 --name atlas32 --quiet
-  taskset -c 1 "$bin/jello-scaling" "${common[@]}" --atlas-n 32 --atlas-k 1e7 \
-    --name atlas32stiff --quiet
-  wait "$first"
-  # The reference on both cores (the model's threads), the integrators' runs on one thread.
-  JELLO_THREADS=1 "$bin/jello-scaling" "${common[@]}" --atlas-n 32 --atlas-k 1e8 \
-    --atlas-reference-threads 2 --atlas-references "$out/atlas_references" \
-    --name atlas32stiffest --quiet
+  # One point at a time (two side by side moved projective's figures by up to 40%): the runs on
+  # one thread, the RK4 references on both cores, kept in atlas_references/ so that a rerun only
+  # times the integrators. FALL_N=16 or 32 runs one of them.
+  common+=(--atlas-reference-threads 2 --atlas-references "$out/atlas_references")
+  export JELLO_THREADS=1
+  if [ -z "${FALL_N:-}" ] || [ "$FALL_N" = 16 ]; then
+    "$bin/jello-scaling" "${common[@]}" --atlas-n 16 --name atlas16
+  fi
+  if [ -z "${FALL_N:-}" ] || [ "$FALL_N" = 32 ]; then
+    "$bin/jello-scaling" "${common[@]}" --atlas-n 32 --atlas-k 1e2,1e3,1e4,1e5,1e6 \
+      --name atlas32
+    "$bin/jello-scaling" "${common[@]}" --atlas-n 32 --atlas-k 1e7 --name atlas32stiff
+    "$bin/jello-scaling" "${common[@]}" --atlas-n 32 --atlas-k 1e8 --name atlas32stiffest
+  fi
   rm -f "$out"/atlas{.json,_atlas.csv}
   draw_atlas
   echo "run-experiments: the atlas at N = 16 and 32 in $out/"
