@@ -4,6 +4,7 @@
 // same to the bit (RK4 keeps no history), so that hours of N = 32 may span several runs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -205,6 +206,50 @@ TEST(ScalingCli, ReferenceThreadsNeedOneJob) {
   EXPECT_EQ(run(std::string(JELLO_SCALING) + " --quick --no-grid --atlas-references " +
                 (dir.path() / "file" / "refs").string() + " --out-dir " + dir.path().string()),
             1);
+}
+
+// --atlas-references-only keeps each point's reference and its check and times nothing; a
+// run after it reads them (its rows name their step) instead of computing them again.
+TEST(ScalingCli, ReferencesOnlyKeepsThemForTheTimedRun) {
+  test::TempDir dir;
+  const std::string base = std::string(JELLO_SCALING) +
+                           " --quick --no-grid --atlas-n 4 --atlas-k 1e2 --jobs 1 --out-dir " +
+                           dir.path().string();
+  EXPECT_EQ(run(base + " --atlas-references-only"), 2);  // where would they go?
+  const std::filesystem::path refs = dir.path() / "refs";
+  EXPECT_EQ(
+      run(base + " --atlas-references-only --atlas-trace --atlas-references " + refs.string()), 2);
+  ASSERT_EQ(run(base + " --atlas-references-only --atlas-references " + refs.string()), 0);
+  std::vector<std::string> kept;
+  for (const auto& entry : std::filesystem::directory_iterator(refs)) {
+    kept.push_back(entry.path().filename().string());
+  }
+  // The reference, RK4 at twice its step, and any larger step the check halved.
+  ASSERT_GE(kept.size(), 2u);
+  for (const std::string& name : kept) {
+    EXPECT_EQ(name.rfind("reference_falling_n4_k100_dt", 0), 0u) << name;
+    EXPECT_EQ(slurp(refs / name).find("unfinished"), std::string::npos) << name;
+  }
+  const std::filesystem::path csv = dir.path() / "scaling_atlas.csv";
+  EXPECT_TRUE(readCsv(csv).empty()) << "a references-only run times nothing";
+
+  // The timed run finds them: the files do not change, and its rows name the reference's step
+  // (the smaller of the two files').
+  double referenceDt = 1.0;
+  for (const std::string& name : kept) {
+    std::istringstream text(slurp(refs / name));
+    std::string word;
+    while (text >> word && word != "dt_s") continue;
+    double dt = 0.0;
+    ASSERT_TRUE(text >> dt) << name;
+    referenceDt = std::min(referenceDt, dt);
+  }
+  const std::string before = slurp(refs / kept[0]);
+  ASSERT_EQ(run(base + " --atlas-references " + refs.string()), 0);
+  EXPECT_EQ(slurp(refs / kept[0]), before);
+  const Table rows = readCsv(csv);
+  for (const auto& row : rows) EXPECT_EQ(number(row, "reference_dt_s"), referenceDt);
+  EXPECT_FALSE(rows.empty());
 }
 
 }  // namespace

@@ -49,6 +49,7 @@ struct Options {
   std::string atlasContact = "soft";
   std::string referenceDir;
   bool atlasTrace = false;
+  bool referencesOnly = false;
 };
 
 // A point of the resolution grid.
@@ -131,6 +132,10 @@ void addAtlasOptions(CLI::App& app, Options& opt) {
                "Instead of the atlas's search, the visible motion over time (NAME_trace.csv): the "
                "reference's, and each integrator's at its largest step (cvode: its loosest "
                "tolerance)");
+  app.add_flag("--atlas-references-only", opt.referencesOnly,
+               "Compute each atlas point's RK4 reference and its check into --atlas-references "
+               "and run no integrator (the references of a long atlas on every core first, the "
+               "timed runs later: a rerun reads them); the atlas CSV then has no rows");
 }
 
 void applyDefaults(const Study& study, Options& opt) {
@@ -238,6 +243,7 @@ void runAtlasPoint(double ak, int an, AtlasScene scene, AtlasContact contact, co
     }
     return;
   }
+  if (opt.referencesOnly) return;
   const AtlasReference& reference = *found;
   if (opt.atlasTrace) atlasTrace(w, ak, an, std::nullopt, reference, opt.atlas, traceRows);
   for (IntegratorKind kind : atlasIntegrators(quick)) {
@@ -318,6 +324,10 @@ int main(int argc, char** argv) {
     if (opt.atlas.referenceThreads > 0 && study.jobs > 1) {
       return "--atlas-reference-threads needs --jobs 1 (with several jobs each holds a CPU)";
     }
+    if (opt.referencesOnly && (opt.referenceDir.empty() || opt.atlasTrace)) {
+      return "--atlas-references-only needs --atlas-references DIR (where they are kept) and "
+             "no --atlas-trace";
+    }
     return opt.atlasScene == "free" && opt.atlasContact != "soft"
                ? "--atlas-contact is the falling scene's floor: the free scene touches nothing"
                : "";
@@ -350,6 +360,7 @@ int main(int argc, char** argv) {
   if (!ok) return 1;
   nlohmann::json parameters = scalingParameters(opt, study, scene, contact);
   parameters["atlas"]["trace"] = opt.atlasTrace;
+  parameters["atlas"]["references_only"] = opt.referencesOnly;
   return study.finish(
       table, parameters,
       {{opt.atlasTrace ? "trace" : "atlas", opt.atlasTrace ? &traceRows : &atlasRows}});
