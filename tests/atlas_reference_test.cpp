@@ -250,6 +250,10 @@ TEST(ScalingCli, ReferencesOnlyKeepsThemForTheTimedRun) {
   const Table rows = readCsv(csv);
   for (const auto& row : rows) EXPECT_EQ(number(row, "reference_dt_s"), referenceDt);
   EXPECT_FALSE(rows.empty());
+  // And every run its searches made, one row each (NAME_tries.csv).
+  double tried = 0.0;
+  for (const auto& row : rows) tried += number(row, "tried");
+  EXPECT_EQ(double(readCsv(dir.path() / "scaling_tries.csv").size()), tried);
 }
 
 }  // namespace

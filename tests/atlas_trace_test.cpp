@@ -77,5 +77,54 @@ TEST(AtlasTrace, TheReferenceFallsFreelyAndARunsLargestDistanceIsItsAtlasError) 
   EXPECT_NEAR(largest, number(cellRows[0][8]), 1e-12 * largest);
 }
 
+// Every run of the search is kept (NAME_tries.csv), so that how the error falls with the step
+// is seen, not only the step kept: backward Euler on the falling scene loses the whole bounce
+// (about 1 m at the corners) until its step resolves the contact, then converges at first
+// order, its error halving with the step; a run within the tolerance ends the search, the last
+// row then being the atlas's cell.
+TEST(AtlasTries, EveryRunOfTheSearchIsKeptWithItsStepAndError) {
+  const double k = 1e3;
+  const int n = 4;
+  const World w = atlasScene(k, n);
+  AtlasSetup setup;
+  setup.halvings = 8;      // dt = 0.02 to 0.02 / 128
+  setup.tolerance = 1e-9;  // never met: every step is tried
+  const AtlasReference ref = atlasReference(w, k, AtlasScene::Falling, setup);
+  CsvTable cells = atlasTable(), tries = atlasTriesTable();
+  atlasPoint(w, k, n, IntegratorKind::Implicit, ref, setup, cells, &tries);
+  const auto cellRows = cellsOf(cells), rows = cellsOf(tries);
+  ASSERT_EQ(cellRows.size(), 1u);
+  EXPECT_EQ(cellRows[0][10], "not_reached");
+  ASSERT_EQ(rows.size(), 8u);
+  EXPECT_EQ(number(cellRows[0][9]), 8.0);  // tried
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const double dt = number(rows[i][3]);
+    EXPECT_EQ(rows[i][2], "implicit");
+    EXPECT_EQ(dt, setup.interval / std::pow(2.0, double(i)));
+    EXPECT_EQ(number(rows[i][5]), std::lround(setup.time / dt));  // steps
+    EXPECT_EQ(rows[i][8], "1");                                   // finished
+    if (i == 0) continue;
+    // Measured: 1.00, 1.00, 0.99, 0.72, then 0.51, 0.52, 0.58 from dt = 0.000625 s.
+    const double ratio = number(rows[i][7]) / number(rows[i - 1][7]);
+    EXPECT_LT(ratio, 1.0 + 1e-9) << dt;
+    if (dt <= 0.000625) {
+      EXPECT_GT(ratio, 0.4) << dt;
+      EXPECT_LT(ratio, 0.65) << dt;
+    }
+  }
+  EXPECT_GT(number(rows[0][7]), 0.9);                         // the bounce lost, m
+  EXPECT_EQ(number(rows.back()[7]), number(cellRows[0][8]));  // the last run's error
+
+  // Within the tolerance at the sixth step: the search ends there, the cell is its run.
+  setup.tolerance = 0.5 * (number(rows[4][7]) + number(rows[5][7]));
+  CsvTable kept = atlasTable(), some = atlasTriesTable();
+  atlasPoint(w, k, n, IntegratorKind::Implicit, ref, setup, kept, &some);
+  const auto keptRows = cellsOf(kept), someRows = cellsOf(some);
+  ASSERT_EQ(someRows.size(), 6u);
+  EXPECT_EQ(keptRows[0][10], "ok");
+  EXPECT_EQ(number(keptRows[0][4]), number(someRows[5][3]));  // dt_s
+  EXPECT_EQ(number(keptRows[0][8]), number(someRows[5][7]));  // the error
+}
+
 }  // namespace
 }  // namespace jello::experiments

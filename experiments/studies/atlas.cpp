@@ -93,12 +93,14 @@ Attempt attempt(const World& w, IntegratorKind kind, double dt, const SolverOpti
       const StepResult r = sim.step();
       if (!r.ok) {
         a.why = r.message;
+        a.steps = sim.steps();
         return a;
       }
       // At the sample's end and within it every 16 steps: forward Euler's first sample alone at
       // N = 32 and k = 1e8 (its damped limit c/k) is millions of steps, hours.
       if ((i % 16 == 15 || i + 1 == perSample) && wall + secondsSince(t0) > setup.runBudget) {
         a.why = "over the run budget";
+        a.steps = sim.steps();
         return a;
       }
     }
@@ -111,6 +113,13 @@ Attempt attempt(const World& w, IntegratorKind kind, double dt, const SolverOpti
   a.wallPerSecond = wall / setup.time;
   a.steps = sim.steps();
   return a;
+}
+
+// A run's end as a CSV cell (the messages hold commas): "", "budget", "diverged" or "failed".
+std::string whyCell(const Attempt& a) {
+  if (a.finished) return "";
+  if (a.why == "over the run budget") return "budget";
+  return a.why.rfind("diverged", 0) == 0 ? "diverged" : "failed";
 }
 
 // The model's threads set for a scope, and restored after.
@@ -267,8 +276,13 @@ SolverOptions cvodeAt(double rtol) {
 
 }  // namespace
 
+CsvTable atlasTriesTable() {
+  return CsvTable({"k_N_per_m", "n", "integrator", "dt_s", "rtol", "steps", "wall_per_simulated_s",
+                   "visible_error_m", "finished", "why"});
+}
+
 void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const AtlasReference& ref,
-                const AtlasSetup& setup, CsvTable& table) {
+                const AtlasSetup& setup, CsvTable& table, CsvTable* tries) {
   const double wMax = ref.wMax;
   const VisibleMotion visible(n);
   const double nan = std::nan("");
@@ -292,6 +306,11 @@ void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const Atla
     const double dt = isAdaptive(kind) ? setup.interval : steps[i];
     const Attempt a = attempt(w, kind, dt, options, setup, visible, ref);
     ++tried;
+    if (tries) {
+      tries->add({k, long(n), std::string(integratorName(kind)), dt,
+                  isAdaptive(kind) ? rtols[i] : nan, a.steps, a.finished ? a.wallPerSecond : nan,
+                  a.error, long(a.finished), whyCell(a)});
+    }
     if (!a.finished && a.why == "over the run budget") {
       outcome = "budget";
       break;

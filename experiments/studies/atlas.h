@@ -89,8 +89,13 @@ CsvTable atlasTable();
 // visible_error_m (of the run kept, or of the last finished run), tried,
 // outcome ("ok", "not_reached": none of the steps tried was within the tolerance, "budget": the
 // next smaller step would have taken longer than the run budget).
+// `tries`, when given, gets a row for every run of the search (NAME_tries.csv): k, n,
+// integrator, dt_s, rtol, steps, wall_per_simulated_s, visible_error_m (the run's, as far as it
+// went), finished (1, or 0 and why: "budget", "diverged" or "failed"), so that how
+// the error falls with the step (its order, or a floor) is seen, not only the step kept.
 void atlasPoint(const World& w, double k, int n, IntegratorKind kind, const AtlasReference& ref,
-                const AtlasSetup& setup, CsvTable& table);
+                const AtlasSetup& setup, CsvTable& table, CsvTable* tries = nullptr);
+CsvTable atlasTriesTable();
 
 // The visible motion over time (jello-scaling --atlas-trace, issue 39 item 5): the reference's
 // samples (`kind` empty, integrator "reference") or `kind`'s run at its largest candidate step

@@ -230,7 +230,7 @@ void runTask(const Task& t, const Options& opt, CsvTable& table) {
 // one's run at its largest step). A point whose reference fails is reported without one
 // (outcome no_reference) and the run goes on.
 void runAtlasPoint(double ak, int an, AtlasScene scene, AtlasContact contact, const Options& opt,
-                   bool quick, CsvTable& atlasRows, CsvTable& traceRows) {
+                   bool quick, CsvTable& atlasRows, CsvTable& traceRows, CsvTable& triesRows) {
   const World w = atlasScene(ak, an, scene, contact);
   std::optional<AtlasReference> found;
   try {
@@ -250,7 +250,7 @@ void runAtlasPoint(double ak, int an, AtlasScene scene, AtlasContact contact, co
     if (opt.atlasTrace) {
       atlasTrace(w, ak, an, kind, reference, opt.atlas, traceRows);
     } else {
-      atlasPoint(w, ak, an, kind, reference, opt.atlas, atlasRows);
+      atlasPoint(w, ak, an, kind, reference, opt.atlas, atlasRows, &triesRows);
     }
   }
 }
@@ -344,24 +344,24 @@ int main(int argc, char** argv) {
   const std::vector<Task> tasks = gridTasks(opt);
   const std::vector<std::pair<double, int>> points = atlasPoints(opt);
 
-  CsvTable table = scalingTable(), atlasRows = atlasTable(), traceRows = atlasTraceTable();
-  const bool ok =
-      study.run(int(tasks.size() + points.size()), "points",
-                [&](int index) {
-                  const auto i = static_cast<std::size_t>(index);
-                  if (i < tasks.size()) {
-                    runTask(tasks[i], opt, table);
-                    return;
-                  }
-                  const auto [ak, an] = points[i - tasks.size()];
-                  runAtlasPoint(ak, an, scene, contact, opt, study.quick, atlasRows, traceRows);
-                },
-                {&table, &atlasRows, &traceRows});
+  CsvTable table = scalingTable(), atlasRows = atlasTable(), traceRows = atlasTraceTable(),
+           triesRows = atlasTriesTable();
+  const bool ok = study.run(int(tasks.size() + points.size()), "points",
+                            [&](int index) {
+                              const auto i = static_cast<std::size_t>(index);
+                              if (i < tasks.size()) {
+                                runTask(tasks[i], opt, table);
+                                return;
+                              }
+                              const auto [ak, an] = points[i - tasks.size()];
+                              runAtlasPoint(ak, an, scene, contact, opt, study.quick, atlasRows,
+                                            traceRows, triesRows);
+                            },
+                            {&table, &atlasRows, &traceRows, &triesRows});
   if (!ok) return 1;
   nlohmann::json parameters = scalingParameters(opt, study, scene, contact);
   parameters["atlas"]["trace"] = opt.atlasTrace;
   parameters["atlas"]["references_only"] = opt.referencesOnly;
-  return study.finish(
-      table, parameters,
-      {{opt.atlasTrace ? "trace" : "atlas", opt.atlasTrace ? &traceRows : &atlasRows}});
+  if (opt.atlasTrace) return study.finish(table, parameters, {{"trace", &traceRows}});
+  return study.finish(table, parameters, {{"atlas", &atlasRows}, {"tries", &triesRows}});
 }
