@@ -11,14 +11,16 @@
 # redraws the atlas charts. FALL_N=16 or 32 runs one N.
 # `scripts/run-experiments.sh atlas-references` computes those references alone, on both cores
 # (nothing is timed, so a machine busy with other work does no harm; about 1.5 hours at N = 16),
-# so that `atlas` then only times the integrators; FALL_N as above.
+# so that `atlas` then only times the integrators; FALL_N as above. With FREE_K (say 1e7,1e8) it
+# computes instead the free scene's at N = 32 for those k (hours at 1e7 and 1e8), which
+# `FREE_N=32 FREE_K=... scripts/run-experiments.sh atlas-free` then reads and times.
 # `scripts/run-experiments.sh atlas-free` runs the atlas's second scene (the same throw and spin
 # without gravity: no contact) at N = 8, then at N = 16 for k = 1e5, 1e6, 1e7, then at N = 32 for
 # k = 1e2 to 1e6 (a 60 s budget from 16 up), one point at a time on one core (two at a time moved
 # projective's figures by up to 40%; N = 32's references on both cores), into
 # experiments/results/atlas_free/, and draws its charts (about 10, 40 and 60 minutes on a 2-core
 # VM; at N = 32, k = 1e7 and 1e8 the RK4 reference alone takes hours); FREE_N=8, 16 or 32 runs
-# one of them.
+# one of them, FREE_K (with FREE_N=32) other k at N = 32, in a run of their own.
 # `scripts/run-experiments.sh atlas-contact` runs the falling scene's atlas at N = 8 with the floor
 # as stiff as the springs, 20 times stiffer and as the log barrier (--atlas-contact k, 20k,
 # barrier), one point at a time, into experiments/results/atlas_contact_k/, atlas_contact_20k/
@@ -204,10 +206,16 @@ if [ "${1:-}" = atlas ]; then
 fi
 if [ "${1:-}" = atlas-references ]; then
   # The atlas's CSV of such a run has no rows: it goes to build/, not over the committed one.
+  only=("${launch[@]}" "$bin/jello-scaling" --no-grid --jobs 1 ${ranks:+--quiet}
+    --atlas-references-only --out-dir build/atlas-references)
+  if [ -n "${FREE_K:-}" ]; then
+    # The free scene's at N = 32 for FREE_K, which `FREE_N=32 FREE_K=... atlas-free` then reads.
+    "${only[@]}" --atlas-scene free --atlas-n 32 --atlas-k "$FREE_K" \
+      --atlas-references "$out/atlas_free/atlas_references" --name free32
+    exit 0
+  fi
   for n in ${FALL_N:-16 32}; do
-    "${launch[@]}" "$bin/jello-scaling" --no-grid --atlas-n "$n" --jobs 1 ${ranks:+--quiet} \
-      --atlas-references-only --atlas-references "$out/atlas_references" \
-      --out-dir build/atlas-references --name "atlas$n"
+    "${only[@]}" --atlas-n "$n" --atlas-references "$out/atlas_references" --name "atlas$n"
   done
   echo "run-experiments: the atlas's references in $out/atlas_references/"
   exit 0
@@ -233,9 +241,11 @@ if [ "${1:-}" = atlas-free ]; then
     if [ -z "${FREE_N:-}" ] || [ "$FREE_N" = 32 ]; then
       # The runs on one thread of either core (no taskset: the references use both), and the
       # references, minutes of RK4 each, on both.
+      # FREE_K (say 1e7): those k alone, in a run of their own (atlas32k1e7).
       JELLO_THREADS=1 "$bin/jello-scaling" --no-grid --atlas-scene free --atlas-n 32 \
-        --atlas-k 1e2,1e3,1e4,1e5,1e6 --atlas-budget 60 --jobs 1 --atlas-reference-threads 2 \
-        --atlas-references "$free/atlas_references" --name atlas32 --out-dir "$free"
+        --atlas-k "${FREE_K:-1e2,1e3,1e4,1e5,1e6}" --atlas-budget 60 --jobs 1 \
+        --atlas-reference-threads 2 --atlas-references "$free/atlas_references" \
+        --name "atlas32${FREE_K:+k${FREE_K//,/-}}" --out-dir "$free"
     fi
   fi
   draw_free_atlas

@@ -42,6 +42,10 @@ def test_help_names_the_ranks_option():
     result = run("--help")
     assert result.returncode == 0
     assert "--ranks K" in result.stdout and "MPI job" in result.stdout
+    # The references computed apart, and the choice of N and k the long runs take.
+    assert "atlas-references" in result.stdout.splitlines()[0]
+    for knob in ("FALL_N", "FREE_K"):
+        assert knob in result.stdout, knob
 
 
 def test_quick_grids_as_two_rank_mpi_jobs():
