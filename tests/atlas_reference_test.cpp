@@ -212,9 +212,10 @@ TEST(ScalingCli, ReferenceThreadsNeedOneJob) {
 // run after it reads them (its rows name their step) instead of computing them again.
 TEST(ScalingCli, ReferencesOnlyKeepsThemForTheTimedRun) {
   test::TempDir dir;
-  const std::string base = std::string(JELLO_SCALING) +
-                           " --quick --no-grid --atlas-n 4 --atlas-k 1e2 --jobs 1 --out-dir " +
-                           dir.path().string();
+  const std::string withGrid = std::string(JELLO_SCALING) +
+                               " --quick --atlas-n 4 --atlas-k 1e2 --jobs 1 --out-dir " +
+                               dir.path().string();
+  const std::string base = withGrid + " --no-grid";
   EXPECT_EQ(run(base + " --atlas-references-only"), 2);  // where would they go?
   const std::filesystem::path refs = dir.path() / "refs";
   EXPECT_EQ(
@@ -232,6 +233,10 @@ TEST(ScalingCli, ReferencesOnlyKeepsThemForTheTimedRun) {
   }
   const std::filesystem::path csv = dir.path() / "scaling_atlas.csv";
   EXPECT_TRUE(readCsv(csv).empty()) << "a references-only run times nothing";
+  // Nor the resolution grid's runs, asked for or not.
+  ASSERT_EQ(run(withGrid + " --atlas-references-only --atlas-references " + refs.string()), 0);
+  EXPECT_TRUE(readCsv(dir.path() / "scaling.csv").empty());
+  EXPECT_TRUE(readCsv(csv).empty());
 
   // The timed run finds them: the files do not change, and its rows name the reference's step
   // (the smaller of the two files').

@@ -134,8 +134,9 @@ void addAtlasOptions(CLI::App& app, Options& opt) {
                "tolerance)");
   app.add_flag("--atlas-references-only", opt.referencesOnly,
                "Compute each atlas point's RK4 reference and its check into --atlas-references "
-               "and run no integrator (the references of a long atlas on every core first, the "
-               "timed runs later: a rerun reads them); the atlas CSV then has no rows");
+               "and run no integrator, the resolution grid's neither (the references of a long "
+               "atlas on every core first, the timed runs later: a rerun reads them); the CSVs "
+               "then have no rows");
 }
 
 void applyDefaults(const Study& study, Options& opt) {
@@ -341,7 +342,8 @@ int main(int argc, char** argv) {
   const AtlasScene scene = *parseAtlasScene(opt.atlasScene);
   const AtlasContact contact = *parseAtlasContact(opt.atlasContact);
   if (scene == AtlasScene::Slide) opt.atlas.time = kSlideTime;
-  const std::vector<Task> tasks = gridTasks(opt);
+  // References alone: the resolution grid's timed runs are left out too.
+  const std::vector<Task> tasks = opt.referencesOnly ? std::vector<Task>{} : gridTasks(opt);
   const std::vector<std::pair<double, int>> points = atlasPoints(opt);
 
   CsvTable table = scalingTable(), atlasRows = atlasTable(), traceRows = atlasTraceTable(),
