@@ -87,6 +87,14 @@ if [ -n "$ranks" ] && [ "$mode" = charts ]; then
   echo "run-experiments: charts runs nothing: --ranks does not apply" >&2
   exit 2
 fi
+case "${FALL_N:-16}:${FREE_N:-8}" in
+  16:8 | 16:16 | 16:32 | 32:8 | 32:16 | 32:32) ;;
+  *)
+    echo "run-experiments: FALL_N is 16 or 32 and FREE_N 8, 16 or 32 (FALL_N='${FALL_N:-}'," \
+      "FREE_N='${FREE_N:-}')" >&2
+    exit 2
+    ;;
+esac
 set -- ${mode:+"$mode"}
 scripts/install-deps.sh
 bin=${JELLO_BIN:-build/native/bin}  # -march=native: the committed results and figures (README)
@@ -180,7 +188,8 @@ if [ "${1:-}" = atlas ]; then
   if [ -n "$ranks" ]; then
     "${launch[@]}" "$bin/jello-scaling" "${common[@]}" --atlas-n 16,32 \
       --atlas-references "$out/atlas_references" --name atlas --quiet
-    rm -f "$out"/atlas16{.json,_atlas.csv} "$out"/atlas32{,stiff,stiffest}{.json,_atlas.csv}
+    rm -f "$out"/atlas16{.json,_atlas.csv,_tries.csv} \
+      "$out"/atlas32{,stiff,stiffest}{.json,_atlas.csv,_tries.csv}
     draw_atlas
     echo "run-experiments: the atlas at N = 16 and 32 in $out/ ($ranks ranks)"
     exit 0
@@ -199,7 +208,7 @@ if [ "${1:-}" = atlas ]; then
     "$bin/jello-scaling" "${common[@]}" --atlas-n 32 --atlas-k 1e7 --name atlas32stiff
     "$bin/jello-scaling" "${common[@]}" --atlas-n 32 --atlas-k 1e8 --name atlas32stiffest
   fi
-  rm -f "$out"/atlas{.json,_atlas.csv}
+  rm -f "$out"/atlas{.json,_atlas.csv,_tries.csv}
   draw_atlas
   echo "run-experiments: the atlas at N = 16 and 32 in $out/"
   exit 0

@@ -38,6 +38,14 @@ def test_bad_arguments_exit_2_naming_them(args, message):
     assert message in result.stderr
 
 
+@pytest.mark.parametrize("knob, value", [("FALL_N", "8"), ("FREE_N", "64")])
+def test_an_unknown_size_exits_2_naming_it(knob, value):
+    result = subprocess.run(["bash", str(SCRIPT), "atlas"], capture_output=True, text=True,
+                            env={**os.environ, knob: value}, cwd=ROOT, timeout=60)
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert f"{knob}='{value}'" in result.stderr
+
+
 def test_help_names_the_ranks_option():
     result = run("--help")
     assert result.returncode == 0
