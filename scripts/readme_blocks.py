@@ -28,6 +28,7 @@ BLOCKS = {
     "atlas-free-summary": "experiments/README.md",
     "atlas-contact-summary": "experiments/README.md",
     "atlas-slide-summary": "experiments/README.md",
+    "slide-steps": "experiments/README.md",
     "atlas-trace-summary": "experiments/README.md",
     "integrators-table": "solvers/README.md",
     "implicit-steps": "solvers/README.md",

@@ -14,7 +14,8 @@ from experiments/results/work_precision.csv and its sidecar), <!-- implicit-damp
 from work_precision_drift_summary.csv), the crossover atlas's (atlas-summary and atlas-region
 from every *_atlas.csv; atlas-free-summary from experiments/results/atlas_free/;
 atlas-contact-summary from experiments/results/atlas_contact_*/; atlas-slide-summary, the
-friction scene's, from experiments/results/atlas_slide/; atlas-trace-summary, the falling
+friction scene's, from experiments/results/atlas_slide/, and slide-steps, its implicit errors
+against their step, by scripts/slide-steps.py; atlas-trace-summary, the falling
 scene's visible motion over time, from experiments/results/atlas_trace/), each in the
 document scripts/readme_blocks.py names. With --check it changes nothing and exits 1 when a
 document differs from what the data gives (ctest runs it so).
@@ -510,7 +511,36 @@ def atlas_run_text(sidecar, ks):
             f"{' (modified tree)' if sidecar.get('tree_modified') else ''}, "
             f"{sidecar['date_utc'][:10]}, {sidecar['wall_time_s'] / 60:.0f} min"
             f"{' with the resolution grid' if sidecar['parameters']['n'] else ''}"
+            f"{machine_text(sidecar)}"
             + (f" for k = {', '.join(k_text(k) for k in ks)}" if ks else ""))
+
+
+def machine_text(sidecar):
+    """The machine's calibration a sidecar holds: one force evaluation of the 8^3 cube."""
+    t = sidecar.get("machine", {}).get("force_evaluation_8_s")
+    return f", a force evaluation at N = 8 {t * 1e6:.2g} us" if t else ""
+
+
+def machine_spread(subdirectory=""):
+    """The sentence saying how far the machines of an atlas's runs differ, when by 2x or more
+    (an explicit method's cost is force evaluations; a crossover between two runs' cells is then
+    partly the machines'); "" otherwise."""
+    times = {}
+    for n, (_, sidecars) in atlas_sources(subdirectory).items():
+        for sidecar in sidecars:
+            t = sidecar.get("machine", {}).get("force_evaluation_8_s")
+            if t:
+                times.setdefault(n, []).append(t)
+    if not times:
+        return ""
+    every = [t for ts in times.values() for t in ts]
+    if max(every) < 2 * min(every):
+        return ""
+    return ("The runs' machines differ: a force evaluation at N = 8 took " + "; ".join(
+        f"{span([t * 1e6 for t in ts], '{:.2g}')} us in N = {n}'s" for n, ts in sorted(times.items()))
+        + f" (each sidecar's `machine`), {max(every) / min(every):.2g}x from the fastest to the "
+        "slowest. An explicit method's cost is its force evaluations, so a comparison of cells "
+        "made on different machines (the region table's columns) is partly the machines'.")
 
 
 ATLAS_EXPLICIT = {name for name, r in INTEGRATORS.items() if r["explicit"]}
@@ -612,6 +642,9 @@ def atlas_summary(subdirectory=""):
     if not pays and not alone:
         lines.append("At no point is an implicit or adaptive method cheaper than the cheapest "
                      "explicit one.")
+    spread = machine_spread(subdirectory)
+    if spread:
+        lines += ["", spread]
     return "\n".join(lines)
 
 
@@ -782,7 +815,9 @@ def findings():
              "falls onto the course's soft floor (400 N/m), " +
              ("only at " + "; ".join(f"N = {n}, k = {k_text(k)} ({name}, {x:.2g}x)"
                                     for n, k, name, x in falling) if falling else "nowhere") +
-             " in the crossover atlas (N = 8, 16, 32; k = 10^2 to 10^8)" + stiff_floors()
+             " in the crossover atlas (N = 8, 16, 32; k = 10^2 to 10^8"
+             + ("; its runs' machines differ, experiments/README.md says how" if machine_spread()
+                else "") + ")" + stiff_floors()
              + slide_finding() + ".")
     cross = crossover_ms()
     pd = closed_sets.names("Projective")[0]  # the crossover benchmark's subject
@@ -965,6 +1000,7 @@ BLOCKS = {"findings": findings,
           "atlas-contact-summary": atlas_contact_summary,
           "atlas-slide-summary": atlas_slide_summary,
           "atlas-trace-summary": atlas_trace_summary,
+          "slide-steps": lambda: _script("slide-steps").table(),
           "experiments-runtime": experiments_runtime}
 
 

@@ -31,6 +31,13 @@
 # method's 2 s at the friction-limited step is 10-20 s at N = 8: a 20 s budget cut it by the
 # machine's noise), into experiments/results/atlas_slide/ (about 30 and 60 minutes on a 2-core
 # VM); SLIDE_N=8 or 16 runs one of them.
+# `scripts/run-experiments.sh slide-steps` asks the friction scene why the implicit methods miss
+# it: at N = 8, k = 1e4, backward Euler and BDF2 (L-stable, first and second order) in one
+# process, midpoint (second order, not L-stable) and implicit-linear (one solve a step) in
+# another beside it, each from dt = 0.02 s down to 4.9e-6 s (13 steps: static friction's damping
+# rate w_max times the step from 3800 down to 0.92), stopping at the first within 1 cm, every run
+# kept (NAME_tries.csv in experiments/results/slide_steps/; the errors matter here, not the
+# timings), and draws slide_steps.png (about 40 minutes on a 2-core VM).
 # `scripts/run-experiments.sh atlas-trace` runs the falling scene at k = 1e4 for N = 8, 16 and 32
 # with --atlas-trace (the reference's visible motion over time, and each integrator's at its
 # largest step; a 60 s budget a run) into experiments/results/atlas_trace/, and draws it (about
@@ -43,12 +50,13 @@
 # instead of building the native ones (the tests: build/release/bin).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-usage="usage: scripts/run-experiments.sh [quick | atlas | atlas-references | atlas-free | atlas-contact | atlas-slide | atlas-trace | charts] [--ranks K]"
+usage="usage: scripts/run-experiments.sh [quick | atlas | atlas-references | atlas-free | atlas-contact | atlas-slide | slide-steps | atlas-trace | charts] [--ranks K]"
 mode=
 ranks=
 while [ $# -gt 0 ]; do
   case "$1" in
-    quick | atlas | atlas-references | atlas-free | atlas-contact | atlas-slide | atlas-trace | charts)
+    quick | atlas | atlas-references | atlas-free | atlas-contact | atlas-slide | slide-steps | \
+      atlas-trace | charts)
       if [ -n "$mode" ]; then
         echo "run-experiments: '$1' after '$mode': one mode at a time ($usage)" >&2
         exit 2
@@ -162,6 +170,9 @@ if [ "${1:-}" = charts ]; then
   draw_free_atlas
   draw_contact_atlases
   draw_slide_atlas
+  if [ -f "$out/slide_steps/l-stable_tries.csv" ]; then
+    gnuplot -e "dir='$out/slide_steps'" experiments/plots/slide_steps.gp
+  fi
   if [ -f "$out/atlas_trace/scaling_trace.csv" ]; then
     gnuplot -e "dir='$out/atlas_trace'" experiments/plots/atlas_trace.gp
   fi
@@ -301,6 +312,25 @@ if [ "${1:-}" = atlas-slide ]; then
   fi
   draw_slide_atlas
   echo "run-experiments: the friction scene's atlas in $slide/"
+  exit 0
+fi
+if [ "${1:-}" = slide-steps ]; then
+  export OMP_THREAD_LIMIT=1 OPENBLAS_NUM_THREADS=1
+  dir="$out/slide_steps"
+  mkdir -p "$dir"
+  steps=(--no-grid --atlas-scene slide --atlas-n 8 --atlas-k 1e4 --atlas-steps-tried 13
+    --atlas-budget 1200 --jobs 1 --atlas-references "$dir/atlas_references")
+  # The reference first, on both cores; then the two processes, both reading it.
+  "${launch[@]}" "$bin/jello-scaling" "${steps[@]}" --atlas-references-only \
+    --atlas-reference-threads 2 --out-dir build/atlas-references --name slide ${ranks:+--quiet}
+  "${launch[@]}" "$bin/jello-scaling" "${steps[@]}" --atlas-integrators implicit,bdf2 --quiet \
+    --out-dir "$dir" --name l-stable &
+  first=$!
+  "${launch[@]}" "$bin/jello-scaling" "${steps[@]}" --atlas-integrators midpoint,implicit-linear \
+    --out-dir "$dir" --name others ${ranks:+--quiet}
+  wait "$first"
+  gnuplot -e "dir='$dir'" experiments/plots/slide_steps.gp
+  echo "run-experiments: the friction scene's implicit errors against their step in $dir/"
   exit 0
 fi
 if [ "${1:-}" = atlas-trace ]; then

@@ -238,7 +238,8 @@ CsvTable atlasTable() {
 namespace {
 
 // The candidates of a search, largest first: explicit steps from 0.9 of the predicted limit
-// (dividing the sample interval), the others from the interval; cvode's tolerances from 1e-2.
+// (dividing the sample interval), the others from the interval (or setup.firstStep); cvode's
+// tolerances from 1e-2.
 // No steps: an explicit method never stable.
 struct Candidates {
   std::vector<double> steps, rtols;
@@ -249,7 +250,7 @@ Candidates candidates(const World& w, IntegratorKind kind, double wMax, const At
     for (int j = 0; j < setup.halvings; ++j) c.rtols.push_back(std::pow(10.0, -2 - j));
     return c;
   }
-  double dt = setup.interval;
+  double dt = setup.firstStep > 0.0 ? setup.firstStep : setup.interval;
   if (isExplicit(kind)) {
     const double limit = 0.9 * predictedThreshold(kind, wMax, w.dElastic / w.kElastic);
     if (limit <= 0.0) return c;

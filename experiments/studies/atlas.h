@@ -37,6 +37,9 @@ struct AtlasSetup {
   int referenceRefinements = 4;
   double runBudget = 20.0;  // wall seconds: a run that would take longer ends the search
   int halvings = 7;         // step sizes tried per integrator (explicit: below its limit)
+  // s, the first step of the fixed-step methods that are not explicit (0: the sample interval;
+  // else the interval over a whole number), e.g. to trace them at a small step.
+  double firstStep = 0.0;
   // Where references are kept (reference_file.h; empty: nowhere): one found there is used, one
   // computed is written there, and while it is computed its last state every `checkpoint` wall
   // seconds, from which a later run resumes.

@@ -18,6 +18,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "experiments/studies/atlas.h"
@@ -50,6 +51,8 @@ struct Options {
   std::string referenceDir;
   bool atlasTrace = false;
   bool referencesOnly = false;
+  std::vector<std::string> atlasIntegratorNames;  // empty: every integrator (--quick: its picks)
+  std::vector<IntegratorKind> atlasKinds;
 };
 
 // A point of the resolution grid.
@@ -110,6 +113,19 @@ void addAtlasOptions(CLI::App& app, Options& opt) {
                  "or the log barrier with kappa = k and dhat 5 mm (barrier)")
       ->check(CLI::IsMember(contactNames()))
       ->capture_default_str();
+  app.add_option("--atlas-integrators", opt.atlasIntegratorNames,
+                 "The atlas's integrators (default all; --quick: five): " + namedIntegratorsHelp())
+      ->delimiter(',');
+  app.add_option(
+         "--atlas-steps-tried", opt.atlas.halvings,
+         "Steps tried per integrator, each half the last (cvode: tolerances, each a tenth), "
+         "while the budget allows (--quick: 4)")
+      ->check(jello::cli::range(1, 30))
+      ->capture_default_str();
+  app.add_option("--atlas-first-step", opt.atlas.firstStep,
+                 "First step of the implicit and projective methods, s: the sample interval 0.02 "
+                 "over a whole number (default the interval; with --atlas-trace, the step traced)")
+      ->check(jello::cli::range(1e-9, 1.0));
   app.add_option("--atlas-budget", opt.atlas.runBudget,
                  "Wall seconds of one atlas run beyond which smaller steps are not tried")
       ->check(jello::cli::range(1e-3, 1e6))
@@ -146,7 +162,7 @@ void applyDefaults(const Study& study, Options& opt) {
     if (!study.given("--budget")) opt.budget = 0.3;
     if (!study.given("--atlas-k") && !study.given("--no-atlas")) opt.atlasK = {1e3, 1e5};
     if (!study.given("--atlas-n")) opt.atlasN = {8};
-    opt.atlas.halvings = 4;
+    if (!study.given("--atlas-steps-tried")) opt.atlas.halvings = 4;
   }
   if (opt.noGrid) opt.ns.clear();
 }
@@ -231,7 +247,7 @@ void runTask(const Task& t, const Options& opt, CsvTable& table) {
 // one's run at its largest step). A point whose reference fails is reported without one
 // (outcome no_reference) and the run goes on.
 void runAtlasPoint(double ak, int an, AtlasScene scene, AtlasContact contact, const Options& opt,
-                   bool quick, CsvTable& atlasRows, CsvTable& traceRows, CsvTable& triesRows) {
+                   CsvTable& atlasRows, CsvTable& traceRows, CsvTable& triesRows) {
   const World w = atlasScene(ak, an, scene, contact);
   std::optional<AtlasReference> found;
   try {
@@ -239,7 +255,7 @@ void runAtlasPoint(double ak, int an, AtlasScene scene, AtlasContact contact, co
   } catch (const AtlasReferenceFailed& e) {
     std::fprintf(stderr, "jello-scaling: k = %g, N = %d: %s\n", ak, an, e.what());
     const double wMax = atlasMaxFrequency(w, scene);
-    for (IntegratorKind kind : atlasIntegrators(quick)) {
+    for (IntegratorKind kind : opt.atlasKinds) {
       atlasNoReference(ak, an, wMax, kind, atlasRows);
     }
     return;
@@ -247,7 +263,7 @@ void runAtlasPoint(double ak, int an, AtlasScene scene, AtlasContact contact, co
   if (opt.referencesOnly) return;
   const AtlasReference& reference = *found;
   if (opt.atlasTrace) atlasTrace(w, ak, an, std::nullopt, reference, opt.atlas, traceRows);
-  for (IntegratorKind kind : atlasIntegrators(quick)) {
+  for (IntegratorKind kind : opt.atlasKinds) {
     if (opt.atlasTrace) {
       atlasTrace(w, ak, an, kind, reference, opt.atlas, traceRows);
     } else {
@@ -259,7 +275,7 @@ void runAtlasPoint(double ak, int an, AtlasScene scene, AtlasContact contact, co
 nlohmann::json scalingParameters(const Options& opt, const Study& study, const AtlasScene& scene,
                                  AtlasContact contact) {
   std::vector<std::string> atlasNames;
-  for (IntegratorKind kind : atlasIntegrators(study.quick)) {
+  for (IntegratorKind kind : opt.atlasKinds) {
     atlasNames.emplace_back(integratorName(kind));
   }
   const AtlasSetup& atlas = opt.atlas;
@@ -302,11 +318,41 @@ nlohmann::json scalingParameters(const Options& opt, const Study& study, const A
             {"reference_threads", atlas.referenceThreads},
             {"run_budget_s", atlas.runBudget},
             {"steps_tried", atlas.halvings},
+            {"implicit_start_s", atlas.firstStep > 0.0 ? atlas.firstStep : atlas.interval},
             {"explicit_start", "0.9 times the predicted limit"},
-            {"implicit_start_s", atlas.interval},
             {"integrators", atlasNames}}},
           {"jobs", study.jobs},
           {"quick", study.quick}};
+}
+
+// What the options cannot mean together ("" when nothing), the atlas's integrators set.
+std::string checkOptions(const Study& study, Options& opt) {
+  if (opt.atlas.referenceThreads > 0 && study.jobs > 1) {
+    return "--atlas-reference-threads needs --jobs 1 (with several jobs each holds a CPU)";
+  }
+  auto named = namedIntegrators(opt.atlasIntegratorNames, atlasIntegrators(study.quick));
+  if (const std::string* unknown = std::get_if<std::string>(&named)) {
+    return "--atlas-integrators: unknown integrator '" + *unknown +
+           "' (known: " + namedIntegratorsHelp() + ")";
+  }
+  opt.atlasKinds = std::get<std::vector<IntegratorKind>>(std::move(named));
+  if (const double first = opt.atlas.firstStep; first > 0.0) {
+    const double ratio = opt.atlas.interval / first;
+    if (ratio < 1.0 - 1e-9 || std::abs(ratio - std::round(ratio)) > 1e-6 * ratio) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "--atlas-first-step %g: not the sample interval (%g s) over a whole number",
+                    first, opt.atlas.interval);
+      return text;
+    }
+  }
+  if (opt.referencesOnly && (opt.referenceDir.empty() || opt.atlasTrace)) {
+    return "--atlas-references-only needs --atlas-references DIR (where they are kept) and "
+           "no --atlas-trace";
+  }
+  return opt.atlasScene == "free" && opt.atlasContact != "soft"
+             ? "--atlas-contact is the falling scene's floor: the free scene touches nothing"
+             : "";
 }
 
 }  // namespace
@@ -321,18 +367,7 @@ int main(int argc, char** argv) {
       "CI: N = 6 and 8, 0.3 s per point; the atlas at k = 1e3 and 1e5, N = 8, with symplectic, "
       "rk4, implicit, midpoint and projective, 4 steps tried each",
       "Points run in parallel (1 gives timings free of a neighbour's memory traffic)");
-  const auto code = study.start(argc, argv, [&]() -> std::string {
-    if (opt.atlas.referenceThreads > 0 && study.jobs > 1) {
-      return "--atlas-reference-threads needs --jobs 1 (with several jobs each holds a CPU)";
-    }
-    if (opt.referencesOnly && (opt.referenceDir.empty() || opt.atlasTrace)) {
-      return "--atlas-references-only needs --atlas-references DIR (where they are kept) and "
-             "no --atlas-trace";
-    }
-    return opt.atlasScene == "free" && opt.atlasContact != "soft"
-               ? "--atlas-contact is the falling scene's floor: the free scene touches nothing"
-               : "";
-  });
+  const auto code = study.start(argc, argv, [&]() { return checkOptions(study, opt); });
   if (code) return *code;
   if (!opt.referenceDir.empty() &&
       !study.ranks().prepareOutput(study.program(), opt.referenceDir, "reference")) {
@@ -348,18 +383,18 @@ int main(int argc, char** argv) {
 
   CsvTable table = scalingTable(), atlasRows = atlasTable(), traceRows = atlasTraceTable(),
            triesRows = atlasTriesTable();
-  const bool ok = study.run(int(tasks.size() + points.size()), "points",
-                            [&](int index) {
-                              const auto i = static_cast<std::size_t>(index);
-                              if (i < tasks.size()) {
-                                runTask(tasks[i], opt, table);
-                                return;
-                              }
-                              const auto [ak, an] = points[i - tasks.size()];
-                              runAtlasPoint(ak, an, scene, contact, opt, study.quick, atlasRows,
-                                            traceRows, triesRows);
-                            },
-                            {&table, &atlasRows, &traceRows, &triesRows});
+  const bool ok =
+      study.run(int(tasks.size() + points.size()), "points",
+                [&](int index) {
+                  const auto i = static_cast<std::size_t>(index);
+                  if (i < tasks.size()) {
+                    runTask(tasks[i], opt, table);
+                    return;
+                  }
+                  const auto [ak, an] = points[i - tasks.size()];
+                  runAtlasPoint(ak, an, scene, contact, opt, atlasRows, traceRows, triesRows);
+                },
+                {&table, &atlasRows, &traceRows, &triesRows});
   if (!ok) return 1;
   nlohmann::json parameters = scalingParameters(opt, study, scene, contact);
   parameters["atlas"]["trace"] = opt.atlasTrace;

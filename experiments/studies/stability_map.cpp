@@ -14,6 +14,7 @@
 #include "experiments/studies/csv_table.h"
 #include "experiments/studies/stability_analysis.h"
 #include "experiments/studies/study.h"
+#include "experiments/studies/study_integrators.h"
 #include "solvers/simulation.h"
 #include "src/base/finite_options.h"
 
@@ -48,7 +49,9 @@ void addOptions(CLI::App& app, Options& opt) {
   app.add_option("--scenes", opt.scenes, "Scenes: free (no contact), wall (resting on the floor)")
       ->check(CLI::IsMember({"free", "wall"}))
       ->delimiter(',');
-  app.add_option("--integrators", opt.integrators, "Integrators (default all)")->delimiter(',');
+  app.add_option("--integrators", opt.integrators,
+                 "Integrators (default all): " + namedIntegratorsHelp())
+      ->delimiter(',');
   app.add_option("--damping-ratio", opt.dampingRatio, "Spring damping c/k, s")
       ->check(jello::cli::nonNegative())
       ->capture_default_str();
@@ -79,18 +82,6 @@ void addOptions(CLI::App& app, Options& opt) {
   app.add_option("--rtol", opt.rtol, "cvode's relative tolerance")
       ->check(jello::cli::positive())
       ->capture_default_str();
-}
-
-// The integrators the options name (all when none), or the unknown name.
-std::variant<std::vector<IntegratorKind>, std::string> integrators(const Options& opt) {
-  std::vector<IntegratorKind> kinds;
-  for (const std::string& name : opt.integrators) {
-    const auto kind = parseIntegratorName(name);
-    if (!kind) return name;
-    kinds.push_back(*kind);
-  }
-  if (kinds.empty()) kinds.assign(allIntegrators().begin(), allIntegrators().end());
-  return kinds;
 }
 
 // --quick's defaults where the options did not say, and the full grid's stiffnesses.
@@ -176,9 +167,10 @@ int main(int argc, char** argv) {
   study.addCommonOptions("Small grid for CI: k = 100 and 10^4, free scene, 0.1 s, 5% bisection");
   std::vector<IntegratorKind> kinds;
   const auto checked = study.start(argc, argv, [&]() -> std::string {
-    auto named = integrators(opt);
+    auto named =
+        namedIntegrators(opt.integrators, {allIntegrators().begin(), allIntegrators().end()});
     if (const std::string* unknown = std::get_if<std::string>(&named)) {
-      return "unknown integrator '" + *unknown + "' (known: " + integratorNameList() + ")";
+      return "unknown integrator '" + *unknown + "' (known: " + namedIntegratorsHelp() + ")";
     }
     kinds = std::get<std::vector<IntegratorKind>>(std::move(named));
     return "";

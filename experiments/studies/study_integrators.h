@@ -5,6 +5,8 @@
 // solvers the scaling study compares.
 #pragma once
 
+#include <string>
+#include <variant>
 #include <vector>
 
 #include "src/world/integrator_table.h"
@@ -25,6 +27,14 @@ std::vector<IntegratorKind> fixedStepIntegrators();
 // The first integrator of each A-stable linear model, in the models' order (backward Euler,
 // BDF2, trapezoidal): the artificial damping the modal theory predicts (mode_theory.h).
 std::vector<IntegratorKind> dampingRepresentatives();
+
+// The integrators a study's --integrators option names, each an integrator's name or a family's
+// ("explicit", "newton", "linearized", "cvode", "projective": its integrators in the table's
+// order), none twice; `all` when none is named. The unknown name when one is.
+std::variant<std::vector<IntegratorKind>, std::string> namedIntegrators(
+    const std::vector<std::string>& names, const std::vector<IntegratorKind>& all);
+// "integrator names, or the families explicit, newton, ...": for the option's help and error.
+std::string namedIntegratorsHelp();
 
 // The quick grids' picks. The atlas: the two explicit methods with a limit, Newton's first- and
 // second-order steps and projective (experiments_test asserts on each). The drift: the same

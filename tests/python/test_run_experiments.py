@@ -52,6 +52,8 @@ def test_help_names_the_ranks_option():
     assert "--ranks K" in result.stdout and "MPI job" in result.stdout
     # The references computed apart, and the choice of N and k the long runs take.
     assert "atlas-references" in result.stdout.splitlines()[0]
+    # The friction scene's errors against the step (its own mode).
+    assert "slide-steps" in result.stdout.splitlines()[0]
     for knob in ("FALL_N", "FREE_K"):
         assert knob in result.stdout, knob
 
