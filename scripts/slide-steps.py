@@ -11,7 +11,6 @@ the block.
 import csv
 import glob
 import json
-import math
 import os
 import sys
 
@@ -46,14 +45,11 @@ def _cell(row):
     return f"{100 * float(row['visible_error_m']):.2g}"
 
 
-def _order(rows):
-    """The slope of log(error) over log(dt) between the two smallest steps finished, or None."""
-    done = [r for r in rows if r["finished"] == "1"]
-    if len(done) < 2:
-        return None
-    a, b = done[-2], done[-1]
-    return (math.log(float(a["visible_error_m"]) / float(b["visible_error_m"]))
-            / math.log(float(a["dt_s"]) / float(b["dt_s"])))
+def _rises(rows):
+    """(how many halvings raised the error, how many halvings there were) over the finished
+    runs, each against the one before it."""
+    done = [float(r["visible_error_m"]) for r in rows if r["finished"] == "1"]
+    return sum(b > a for a, b in zip(done, done[1:])), max(len(done) - 1, 0)
 
 
 def table(where=DIR):
@@ -90,12 +86,12 @@ def table(where=DIR):
         mine = [by[(n, dt)] for dt in steps if (n, dt) in by]
         within = [r for r in mine if r["finished"] == "1"
                   and float(r["visible_error_m"]) <= tolerance]
-        order = _order(mine)
+        rises, halvings = _rises(mine)
         text = (f"`{n}` within {100 * tolerance:g} cm from dt = {float(within[0]['dt_s']):.3g} s "
                 f"(h w_max = {float(within[0]['dt_s']) * w_max:.2g})" if within
                 else f"`{n}` never within {100 * tolerance:g} cm")
-        if order is not None:
-            text += f", the error's slope over its two smallest steps {order:.2g}"
+        if halvings:
+            text += f", its error higher after {rises} of its {halvings} halvings"
         said.append(text)
     lines += ["", "; ".join(said) + "."]
     return "\n".join(lines)

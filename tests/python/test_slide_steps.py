@@ -47,9 +47,18 @@ def test_errors_by_step_from_both_processes(tmp_path):
     assert lines[4] == "| 0.02 | 20 | 20 | 30 |"
     assert lines[5] == "| 0.01 | 10 | 10 | over budget |"
     assert lines[7] == "| 0.0025 | 2.5 | 0.8 |  |"
-    # Where each is within 1 cm, and the slope of its last two finished steps.
-    slope = "2.6"  # log(0.05 / 0.008) / log 2
-    assert (f"`implicit` within 1 cm from dt = 0.0025 s (h w_max = 2.5), the error's slope over "
-            f"its two smallest steps {slope}") in lines[-1]
-    assert "`projective` never within 1 cm" in lines[-1]
-    assert "projective` never within 1 cm, the error's slope" not in lines[-1]
+    # Where each is within 1 cm, and how often a halving raised its error (none for backward
+    # Euler here, its error falling steadily; projective finished one run: no halving).
+    assert ("`implicit` within 1 cm from dt = 0.0025 s (h w_max = 2.5), its error higher after 0 "
+            "of its 3 halvings") in lines[-1]
+    assert "`projective` never within 1 cm." in lines[-1]
+
+
+def test_an_error_that_rises_as_the_step_falls_is_counted(tmp_path):
+    slide = module()
+    write_run(tmp_path, "one", [
+        f"10000,8,bdf2,{dt},,{round(2 / dt)},1.0,{e},1,\n"
+        for dt, e in ((0.02, 0.1), (0.01, 0.12), (0.005, 0.03), (0.0025, 0.09))],
+        ["10000,8,1000,bdf2,,,0,,0.09,4,not_reached,1e-5,1e-4\n"], 60)
+    assert "`bdf2` never within 1 cm, its error higher after 2 of its 3 halvings." in (
+        slide.table(tmp_path).splitlines()[-1])
