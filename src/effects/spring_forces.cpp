@@ -66,10 +66,14 @@ constexpr int kFusedMinDelta = 8;
 // The scalar the force on the base point is d times (see the header).
 inline double springScale(double dx, double dy, double dz, double wx, double wy, double wz,
                           double k, double c, double L0, double mask) {
-  const double l2 = dx * dx + dy * dy + dz * dz;
+  // A missing spring's (mask 0) squared length is taken as 1, so its scale is finite and times
+  // its mask is 0: 0 * inf never makes a NaN; a spring's (mask 1) is its own, exactly. Written
+  // as arithmetic, not a select: GCC sank a select's arms into a branch (floating-point
+  // operations may trap), which only AVX-512's masks vectorize; on AVX2 (Zen 3, and the
+  // portable build's x86-64-v3 clone) these loops ran scalar, several times slower.
+  const double l2 = mask * (dx * dx + dy * dy + dz * dz) + (1.0 - mask);
   const double inv = 1.0 / std::sqrt(l2);
-  const double scale = k * (1.0 - L0 * inv) + c * (dx * wx + dy * wy + dz * wz) * (inv * inv);
-  return mask != 0.0 ? scale : 0.0;  // a select, so 0 * inf never makes a NaN
+  return mask * (k * (1.0 - L0 * inv) + c * (dx * wx + dy * wy + dz * wz) * (inv * inv));
 }
 
 // A group with delta >= kFusedMinDelta: one pass adds the force to both ends. Arrays are
