@@ -37,7 +37,7 @@
 # another beside it, each from dt = 0.02 s down to 4.9e-6 s (13 steps: static friction's damping
 # rate w_max times the step from 3800 down to 0.92), stopping at the first within 1 cm, every run
 # kept (NAME_tries.csv in experiments/results/slide_steps/; the errors matter here, not the
-# timings), and draws slide_steps.png (about 40 minutes on a 2-core VM).
+# timings), and draws slide_steps.png (about 20 minutes on a 2-core VM).
 # `scripts/run-experiments.sh atlas-trace` runs the falling scene at k = 1e4 for N = 8, 16 and 32
 # with --atlas-trace (the reference's visible motion over time, and each integrator's at its
 # largest step; a 60 s budget a run) into experiments/results/atlas_trace/, and draws it (about
