@@ -423,6 +423,12 @@ def slide_finding():
     if over:
         said.append(f"{', '.join(over)} {'runs' if len(over) == 1 else 'run'} over the budget "
                     "before keeping it")
+    steps = _script("slide-steps").within()
+    if steps and steps[1]:
+        said.append("with steps that resolve static friction (N = 8, k = 10^4, down to h w_max = "
+                    f"{steps[0]:.2g}) " + " and ".join(f"{name} from h w_max = {hw:.2g}"
+                                                       for name, hw in steps[1])
+                    + " keep it within 1 cm, experiments/README.md shows why")
     return ("; sliding to rest on an incline with friction (mu = 0.6) the cheapest within 1 cm is "
             + "; ".join(cells) + (" (" + "; ".join(said) + ")" if said else ""))
 

@@ -52,6 +52,24 @@ def _rises(rows):
     return sum(b > a for a, b in zip(done, done[1:])), max(len(done) - 1, 0)
 
 
+def within(where=DIR):
+    """(smallest h w_max tried, [(integrator, h w_max of its first run within the tolerance)])
+    in the integrator table's order, or None when it has not run."""
+    if not ran(where):
+        return None
+    tries = _read("_tries.csv", where)
+    w_max = float(_read("_atlas.csv", where)[0]["w_max_rad_per_s"])
+    with open(_files(".json", where)[0]) as f:
+        tolerance = json.load(f)["parameters"]["atlas"]["tolerance_m"]
+    found = []
+    for r in closed_sets.integrators():
+        ok = [t for t in tries if t["integrator"] == r["name"] and t["finished"] == "1"
+              and float(t["visible_error_m"]) <= tolerance]
+        if ok:
+            found.append((r["name"], float(ok[0]["dt_s"]) * w_max))
+    return min(float(t["dt_s"]) for t in tries) * w_max, found
+
+
 def table(where=DIR):
     """The block from the runs in `where`."""
     if not ran(where):

@@ -62,3 +62,15 @@ def test_an_error_that_rises_as_the_step_falls_is_counted(tmp_path):
         ["10000,8,1000,bdf2,,,0,,0.09,4,not_reached,1e-5,1e-4\n"], 60)
     assert "`bdf2` never within 1 cm, its error higher after 2 of its 3 halvings." in (
         slide.table(tmp_path).splitlines()[-1])
+
+
+def test_within_names_the_first_step_within_the_tolerance(tmp_path):
+    slide = module()
+    assert slide.within(tmp_path) is None
+    write_run(tmp_path, "one", [
+        f"10000,8,bdf2,{dt},,{round(2 / dt)},1.0,{e},1,\n"
+        for dt, e in ((0.02, 0.1), (0.01, 0.005), (0.005, 0.003))],
+        ["10000,8,1000,bdf2,0.01,,200,1.0,0.005,2,ok,1e-5,1e-4\n"], 60)
+    smallest, found = slide.within(tmp_path)
+    assert smallest == 5.0  # 0.005 s at w_max 1000 rad/s
+    assert found == [("bdf2", 10.0)]
