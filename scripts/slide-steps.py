@@ -52,21 +52,34 @@ def _rises(rows):
     return sum(b > a for a, b in zip(done, done[1:])), max(len(done) - 1, 0)
 
 
+def _load(where):
+    """The runs in `where`: every try, every sidecar, w_max and the tolerance."""
+    sidecars = []
+    for path in _files(".json", where):
+        with open(path) as f:
+            sidecars.append(json.load(f))
+    return (_read("_tries.csv", where), sidecars,
+            float(_read("_atlas.csv", where)[0]["w_max_rad_per_s"]),
+            sidecars[0]["parameters"]["atlas"]["tolerance_m"])
+
+
+def _first_within(rows, tolerance):
+    """The first finished run within the tolerance, or None."""
+    return next((r for r in rows if r["finished"] == "1"
+                 and float(r["visible_error_m"]) <= tolerance), None)
+
+
 def within(where=DIR):
     """(smallest h w_max tried, [(integrator, h w_max of its first run within the tolerance)])
     in the integrator table's order, or None when it has not run."""
     if not ran(where):
         return None
-    tries = _read("_tries.csv", where)
-    w_max = float(_read("_atlas.csv", where)[0]["w_max_rad_per_s"])
-    with open(_files(".json", where)[0]) as f:
-        tolerance = json.load(f)["parameters"]["atlas"]["tolerance_m"]
+    tries, _, w_max, tolerance = _load(where)
     found = []
     for r in closed_sets.integrators():
-        ok = [t for t in tries if t["integrator"] == r["name"] and t["finished"] == "1"
-              and float(t["visible_error_m"]) <= tolerance]
+        ok = _first_within([t for t in tries if t["integrator"] == r["name"]], tolerance)
         if ok:
-            found.append((r["name"], float(ok[0]["dt_s"]) * w_max))
+            found.append((r["name"], float(ok["dt_s"]) * w_max))
     return min(float(t["dt_s"]) for t in tries) * w_max, found
 
 
@@ -74,14 +87,7 @@ def table(where=DIR):
     """The block from the runs in `where`."""
     if not ran(where):
         return "Not run yet (`scripts/run-experiments.sh slide-steps`)."
-    tries = _read("_tries.csv", where)
-    cells = _read("_atlas.csv", where)
-    sidecars = []
-    for path in _files(".json", where):
-        with open(path) as f:
-            sidecars.append(json.load(f))
-    w_max = float(cells[0]["w_max_rad_per_s"])
-    tolerance = sidecars[0]["parameters"]["atlas"]["tolerance_m"]
+    tries, sidecars, w_max, tolerance = _load(where)
     commits = sorted({s["commit"][:7] for s in sidecars})
     dates = sorted({s["date_utc"][:10] for s in sidecars})
     minutes = max(s["wall_time_s"] for s in sidecars) / 60
@@ -102,11 +108,10 @@ def table(where=DIR):
     said = []
     for n in names:
         mine = [by[(n, dt)] for dt in steps if (n, dt) in by]
-        within = [r for r in mine if r["finished"] == "1"
-                  and float(r["visible_error_m"]) <= tolerance]
+        first = _first_within(mine, tolerance)
         rises, halvings = _rises(mine)
-        text = (f"`{n}` within {100 * tolerance:g} cm from dt = {float(within[0]['dt_s']):.3g} s "
-                f"(h w_max = {float(within[0]['dt_s']) * w_max:.2g})" if within
+        text = (f"`{n}` within {100 * tolerance:g} cm from dt = {float(first['dt_s']):.3g} s "
+                f"(h w_max = {float(first['dt_s']) * w_max:.2g})" if first
                 else f"`{n}` never within {100 * tolerance:g} cm")
         if halvings:
             text += f", its error higher after {rises} of its {halvings} halvings"

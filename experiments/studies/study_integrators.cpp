@@ -4,6 +4,8 @@
 #include <cctype>
 #include <optional>
 
+#include "src/base/closed_set.h"
+
 namespace jello::experiments {
 
 std::vector<IntegratorKind> studyOrder() {
@@ -47,7 +49,7 @@ std::string lower(std::string_view s) {
 
 std::optional<IntegratorFamily> parseFamily(const std::string& name) {
   for (IntegratorFamily family : kFamilies) {
-    if (lower(familyName(family)) == lower(name)) return family;
+    if (closed_set::equalsIgnoreCase(familyName(family), name)) return family;
   }
   return std::nullopt;
 }
