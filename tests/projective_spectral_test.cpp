@@ -4,7 +4,7 @@
 // far as with the factor of the exact matrix.
 #include <gtest/gtest.h>
 
-#include <Eigen/Dense>
+#include <Eigen/Core>
 #include <cstdio>
 #include <map>
 #include <string>
@@ -35,7 +35,7 @@ Eigen::MatrixXd denseBound(LatticeSpectral& bound) {
   const int n = bound.numPoints();
   Eigen::MatrixXd inverse = Eigen::MatrixXd::Identity(n, n);
   for (int col = 0; col < n; ++col) bound.solve(inverse.col(col).data(), 1);
-  return inverse.inverse();
+  return test::inverse(inverse);
 }
 
 TEST(LatticeSpectral, BoundsTheLaplacianFromAboveAndEqualsItInside) {
@@ -54,7 +54,7 @@ TEST(LatticeSpectral, BoundsTheLaplacianFromAboveAndEqualsItInside) {
     EXPECT_LE((bound - bound.transpose()).cwiseAbs().maxCoeff(), 1e-9 * scale);
     // P' - P is positive semidefinite: P' majorizes the energy.
     const Eigen::MatrixXd gap = 0.5 * (bound + bound.transpose()) - P;
-    const double lowest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(gap).eigenvalues()(0);
+    const double lowest = test::symmetricEigenvalues(gap)(0);
     EXPECT_GE(lowest, -1e-9 * scale);
     // Rows of points two or more from every face (every spring's partner inside): equal.
     const Lattice lattice{resolution};
@@ -65,9 +65,8 @@ TEST(LatticeSpectral, BoundsTheLaplacianFromAboveAndEqualsItInside) {
           EXPECT_LE((bound.row(p) - P.row(p)).cwiseAbs().maxCoeff(), 1e-9 * scale) << p;
         }
     // And not far above P: P'^-1 P's eigenvalues in (0.3, 1] (N = 3: 0.29).
-    const Eigen::VectorXd ratio = Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd>(
-                                      P, 0.5 * (bound + bound.transpose()))
-                                      .eigenvalues();
+    const Eigen::VectorXd ratio =
+        test::generalizedEigenvalues(P, 0.5 * (bound + bound.transpose()));
     // Shown for solvers/README.md's figure; asserted below.
     std::printf("N = %d: P'^-1 P in [%.3f, %.3f]\n", resolution, ratio.minCoeff(),
                 ratio.maxCoeff());

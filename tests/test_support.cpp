@@ -2,6 +2,9 @@
 
 #include <sys/wait.h>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -127,6 +130,23 @@ ModelSpec freeCube(const World& world) {
   spec.sphere.reset();
   spec.field = {};
   return spec;
+}
+
+Eigen::VectorXd symmetricEigenvalues(const Eigen::MatrixXd& a) {
+  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(a, Eigen::EigenvaluesOnly).eigenvalues();
+}
+
+Eigen::VectorXd generalizedEigenvalues(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd>(a, b, Eigen::EigenvaluesOnly)
+      .eigenvalues();
+}
+
+bool choleskySucceeds(const Eigen::MatrixXd& a) {
+  return Eigen::LLT<Eigen::MatrixXd>(a).info() == Eigen::Success;
+}
+
+Eigen::MatrixXd inverse(const Eigen::MatrixXd& a) {
+  return a.inverse();
 }
 
 }  // namespace jello::test

@@ -72,4 +72,15 @@ struct LinearOscillator {
 // jello.w's cube (skewed corner, moving) with walls, plane and field switched off: a free body.
 ModelSpec freeCube(const World& world);
 
+// Dense checks, instantiated here once: Eigen's eigensolvers cost each test file that named
+// them 10-30 s of compile time (more under the sanitizers).
+// The eigenvalues of symmetric a, ascending.
+Eigen::VectorXd symmetricEigenvalues(const Eigen::MatrixXd& a);
+// The eigenvalues l of a v = l b v (a symmetric, b symmetric positive definite), ascending.
+Eigen::VectorXd generalizedEigenvalues(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b);
+// Whether a dense Cholesky factorization of a succeeds (a symmetric positive definite).
+bool choleskySucceeds(const Eigen::MatrixXd& a);
+// The inverse of invertible a (partial-pivoting LU).
+Eigen::MatrixXd inverse(const Eigen::MatrixXd& a);
+
 }  // namespace jello::test

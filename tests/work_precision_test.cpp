@@ -12,7 +12,8 @@
 namespace jello::experiments {
 namespace {
 
-// One --quick run of jello-work-precision (about 20 s) read by the tests below.
+// One --quick run of jello-work-precision (about 12 s) read by the tests below, all in one
+// process (tests/CMakeLists.txt: ONE_PROCESS).
 class WorkPrecisionQuick : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {

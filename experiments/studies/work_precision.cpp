@@ -369,15 +369,8 @@ int main(int argc, char** argv) {
       study.quick ? std::vector<double>{1e-3, 1e-5, 1e-7}
                   : std::vector<double>{1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8};
 
-  std::vector<Scene> scenes;
-  std::optional<DampingStudy> damped;
-  try {
-    scenes = scenesWithReferences(opt, study);
-    damped.emplace(opt, study.quick);
-  } catch (const std::exception& e) {
-    return study.fail(e.what());
-  }
-  const std::vector<Task> tasks = tasksOf(scenes, opt, rtols, study.quick);
+  // The drift runs are planned first: a --drift-k they cannot use fails the run at once, not
+  // after the references.
   const World driftWorld = driftScene(opt.drift);
   std::vector<DriftRun> driftRuns;
   try {
@@ -388,6 +381,15 @@ int main(int argc, char** argv) {
     what << "the drift runs (--drift-k " << opt.drift.k << ") could not be planned: " << e.what();
     return study.fail(what.str());
   }
+  std::vector<Scene> scenes;
+  std::optional<DampingStudy> damped;
+  try {
+    scenes = scenesWithReferences(opt, study);
+    damped.emplace(opt, study.quick);
+  } catch (const std::exception& e) {
+    return study.fail(e.what());
+  }
+  const std::vector<Task> tasks = tasksOf(scenes, opt, rtols, study.quick);
 
   CsvTable table = precisionTable(), damping = dampingTable();
   CsvTable driftSeries = driftSeriesTable(), driftSummary = driftSummaryTable();

@@ -17,6 +17,12 @@ namespace jello {
 // sqrt of the largest eigenvalue of -K/m at `state` (rad/s); K is the exact (unclamped) spring
 // and contact Jacobian. Throws std::runtime_error when Spectra does not converge.
 double maxAngularFrequency(const Model& model, const State& state);
+// The same mode with its shape: w_max and the unit eigenvector (3n: x, y, z blocks).
+struct FastestMode {
+  double wMax = 0.0;  // rad/s
+  Eigen::VectorXd shape;
+};
+FastestMode fastestMode(const Model& model, const State& state);
 
 // The largest h at which `kind` is stable on every mode up to wMax with damping ratio
 // r * w / 2 (r = c/k in s); 0 when never stable, +infinity for the implicit methods and cvode
