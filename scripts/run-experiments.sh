@@ -351,7 +351,9 @@ if [ -n "$ranks" ]; then args+=(--jobs 1 --quiet); fi
 # only: N = 16 and 32 are `scripts/run-experiments.sh atlas` (or `mpirun -np K jello-scaling
 # --atlas-n 16,32` on a cluster).
 atlas_n=(--atlas-n 8)
-[ "${1:-}" = quick ] && atlas_n=()
+# The quick grid's references are kept beside its results: a rerun reads them (a quarter of a
+# minute of RK4 each), as do the tests, from tests/data/atlas-quick-references/.
+[ "${1:-}" = quick ] && atlas_n=(--atlas-references "$out/atlas_references")
 if [ -n "$ranks" ]; then
   "${launch[@]}" "$bin/jello-scaling" "${args[@]}" "${atlas_n[@]}" --out-dir "$out"
 else

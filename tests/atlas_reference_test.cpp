@@ -11,6 +11,8 @@
 #include <random>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "experiments/studies/atlas.h"
 #include "experiments/studies/reference_file.h"
@@ -259,6 +261,54 @@ TEST(ScalingCli, ReferencesOnlyKeepsThemForTheTimedRun) {
   double tried = 0.0;
   for (const auto& row : rows) tried += number(row, "tried");
   EXPECT_EQ(double(readCsv(dir.path() / "scaling_tries.csv").size()), tried);
+}
+
+// A stored reference's tokens, its comment lines left out.
+std::vector<std::string> tokens(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> out;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind('#', 0) == 0) continue;
+    std::istringstream words(line);
+    for (std::string w; words >> w;) out.push_back(w);
+  }
+  return out;
+}
+
+// The quick atlas's tests read their references from tests/data/atlas-quick-references/
+// (quickReferences). Those are today's scenes: recomputed at k = 1e3 (the cheap point; a
+// changed scene changes every k), the falling and the free one, they agree with the kept files
+// to round-off (other machines' vector paths round differently).
+TEST(ScalingCli, TheKeptQuickReferencesAreTodaysScenes) {
+  test::TempDir dir;
+  const std::filesystem::path kept = JELLO_TEST_DATA_DIR "/atlas-quick-references";
+  for (const char* scene : {"falling", "free"}) {
+    SCOPED_TRACE(scene);
+    const std::filesystem::path refs = dir.path() / scene;
+    ASSERT_EQ(run(std::string(JELLO_SCALING) + " --quick --no-grid --atlas-k 1000 --atlas-scene " +
+                  scene + " --atlas-references-only --atlas-references " + refs.string() +
+                  " --out-dir " + dir.path().string()),
+              0);
+    int compared = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(refs)) {
+      const std::filesystem::path stored = kept / entry.path().filename();
+      ASSERT_TRUE(std::filesystem::exists(stored)) << stored;
+      const std::vector<std::string> fresh = tokens(entry.path()), old = tokens(stored);
+      ASSERT_EQ(fresh.size(), old.size()) << stored;
+      for (std::size_t i = 0; i < fresh.size(); ++i) {
+        char* end = nullptr;
+        const double a = std::strtod(fresh[i].c_str(), &end);
+        if (*end != '\0' || fresh[i].empty()) {
+          EXPECT_EQ(fresh[i], old[i]) << stored << " token " << i;  // a name
+          continue;
+        }
+        const double b = std::strtod(old[i].c_str(), nullptr);
+        EXPECT_NEAR(a, b, 1e-9 * std::max(1.0, std::abs(b))) << stored << " token " << i;
+      }
+      ++compared;
+    }
+    EXPECT_EQ(compared, 2);  // the reference and its check at twice its step
+  }
 }
 
 }  // namespace

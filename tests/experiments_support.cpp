@@ -61,4 +61,14 @@ double slope(const std::vector<std::pair<double, double>>& points) {
   return (n * sxy - sx * sy) / (n * sxx - sx * sx);
 }
 
+std::filesystem::path quickReferences(const std::filesystem::path& dir) {
+  const std::filesystem::path refs = dir / "references";
+  std::filesystem::create_directories(refs);
+  for (const auto& entry :
+       std::filesystem::directory_iterator(JELLO_TEST_DATA_DIR "/atlas-quick-references")) {
+    std::filesystem::copy_file(entry.path(), refs / entry.path().filename());
+  }
+  return refs;
+}
+
 }  // namespace jello::experiments

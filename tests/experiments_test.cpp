@@ -270,7 +270,8 @@ TEST(ScalingQuick, EveryIntegratorAndSizeHasItsCostAndTheImplicitSplit) {
 // no damping of its own) keeps the visible motion at steps more than 20 times RK4's at k = 1e5.
 TEST(ScalingQuick, TheAtlasKeepsTheVisibleMotionAndBackwardEulerLosesTheBounce) {
   test::TempDir dir;
-  ASSERT_EQ(run(std::string(JELLO_SCALING) + " --quick --no-grid --out-dir " + dir.path().string()),
+  ASSERT_EQ(run(std::string(JELLO_SCALING) + " --quick --no-grid --atlas-references " +
+                quickReferences(dir.path()).string() + " --out-dir " + dir.path().string()),
             0);
   // --no-grid: the atlas alone, the grid's file only its header.
   ASSERT_TRUE(std::filesystem::exists(dir.path() / "scaling.csv"));
@@ -319,7 +320,8 @@ TEST(ScalingQuick, TheFreeSceneTouchesNothingAndMidpointKeepsItsMotionAtTheLarge
     ASSERT_FALSE(sim.model().inContact(sim.state().x.data())) << "t = " << sim.state().t;
   }
   test::TempDir dir;
-  ASSERT_EQ(run(std::string(JELLO_SCALING) + " --quick --no-grid --atlas-scene free --out-dir " +
+  ASSERT_EQ(run(std::string(JELLO_SCALING) + " --quick --no-grid --atlas-scene free " +
+                "--atlas-references " + quickReferences(dir.path()).string() + " --out-dir " +
                 dir.path().string()),
             0);
   std::ifstream sidecarFile(dir.path() / "scaling.json");

@@ -65,6 +65,9 @@ def test_quick_grids_as_two_rank_mpi_jobs():
     if not shutil.which("mpirun"):
         pytest.skip("no mpirun")
     shutil.rmtree(QUICK, ignore_errors=True)
+    # The quick atlas's RK4 references, kept (ScalingCli.TheKeptQuickReferencesAreTodaysScenes
+    # checks them against today's scenes): the run reads them from its atlas_references/.
+    shutil.copytree(ROOT / "tests" / "data" / "atlas-quick-references", QUICK / "atlas_references")
     result = run("quick", "--ranks", "2", bin_dir=os.path.join(build, "bin"))
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     # Every program ran as one job of two ranks; rank 0 wrote the one CSV.
