@@ -523,8 +523,10 @@ def atlas_run_text(sidecar, ks):
 
 def machine_text(sidecar):
     """The machine's calibration a sidecar holds: one force evaluation of the 8^3 cube."""
-    t = sidecar.get("machine", {}).get("force_evaluation_8_s")
-    return f", a force evaluation at N = 8 {t * 1e6:.2g} us" if t else ""
+    machine = sidecar.get("machine", {})
+    t = machine.get("force_evaluation_8_s")
+    level = f" ({machine['vector_level']})" if "vector_level" in machine else ""
+    return f", a force evaluation at N = 8 {t * 1e6:.2g} us{level}" if t else ""
 
 
 def machine_spread(subdirectory=""):

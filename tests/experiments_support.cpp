@@ -49,6 +49,10 @@ void expectSidecar(const std::filesystem::path& path, const char* program) {
                           "date_utc", "wall_time_s"}) {
     EXPECT_TRUE(j.contains(key)) << key;
   }
+  // The machine as a run's timings need it: its CPU, its vector level, its speed.
+  const std::string level = j.at("machine").at("vector_level");
+  EXPECT_EQ(level.rfind("x86-64", 0), 0u) << level;
+  EXPECT_GT(j.at("machine").at("force_evaluation_8_s").get<double>(), 0.0);
 }
 
 double slope(const std::vector<std::pair<double, double>>& points) {

@@ -42,6 +42,21 @@ std::string cpuModel() {
   return "unknown";
 }
 
+// The highest x86-64 level the CPU supports: the clones a portable build runs
+// (src/base/vector_clones.h). x86-64-v4 has AVX-512, v3 AVX2: loops that vectorize only with
+// AVX-512's masks ran scalar on v3 machines, which a run's timings would otherwise hide.
+std::string vectorLevel() {
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+  __builtin_cpu_init();  // the builtin takes literals only
+  if (__builtin_cpu_supports("x86-64-v4")) return "x86-64-v4";
+  if (__builtin_cpu_supports("x86-64-v3")) return "x86-64-v3";
+  if (__builtin_cpu_supports("x86-64-v2")) return "x86-64-v2";
+  return "x86-64";
+#else
+  return "unknown";
+#endif
+}
+
 // The machine's speed as the run starts: the median over 9 batches of the time of one force
 // evaluation (springs, walls, plane, field) of the default scene's 8^3 cube. These are shared
 // VMs: the same machine type measured the spring forces 4x apart on one day, so timings are
@@ -95,6 +110,7 @@ nlohmann::json runContext(int argc, char** argv) {
       {"OMP_THREAD_LIMIT", std::getenv("OMP_THREAD_LIMIT") ? std::getenv("OMP_THREAD_LIMIT") : ""},
       {"machine",
        {{"cpu", cpuModel()},
+        {"vector_level", vectorLevel()},
         {"cores", std::thread::hardware_concurrency()},
         {"kernel", named ? std::string(u.sysname) + " " + u.release : "unknown"},
         {"arch", named ? u.machine : "unknown"},
