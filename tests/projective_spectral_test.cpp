@@ -189,7 +189,10 @@ TEST(LatticeSpectral, ProjectiveConvergesToTheBackwardEulerStepAsWithTheFactor) 
 // (h = 0.01), projective keeps with the bound: its angular momentum within 1% and its energy
 // within 5% of converged backward Euler's (ten iterations a step, as by default).
 TEST(LatticeSpectral, ProjectiveKeepsTheAngularMomentumAndEnergyLikeBackwardEuler) {
-  const World w = spinningCubeAt(16, 0.0);
+  // Under the sanitizers 16^3 took 34 s of CI; 12^3 runs the same code (the bound fits any
+  // whole lattice; measured there 0.9915 against 0.9918, energies equal to 3 digits).
+  const int n = test::kSanitized ? 12 : 16;
+  const World w = spinningCubeAt(n, 0.0);
   double kept[2], energy[2];
   for (int i = 0; i < 2; ++i) {
     Simulation sim(w, i == 0 ? IntegratorKind::Implicit : IntegratorKind::Projective, 0.01);
@@ -200,9 +203,9 @@ TEST(LatticeSpectral, ProjectiveKeepsTheAngularMomentumAndEnergyLikeBackwardEule
     energy[i] = sim.model().energy(sim.state()).total() / e0;
   }
   std::printf(
-      "16^3: implicit keeps %.4f of the angular momentum and %.4g of the energy, "
+      "%d^3: implicit keeps %.4f of the angular momentum and %.4g of the energy, "
       "projective on the bound %.4f and %.4g (asserted below)\n",
-      kept[0], energy[0], kept[1], energy[1]);
+      n, kept[0], energy[0], kept[1], energy[1]);
   EXPECT_NEAR(kept[1], kept[0], 0.01);
   EXPECT_NEAR(energy[1], energy[0], 0.05 * energy[0]);
 }
