@@ -25,8 +25,8 @@ void expectSidecar(const std::filesystem::path& path, const char* program);
 
 // The quick atlas's RK4 references (N = 8, k = 1e3 and 1e5, falling and free scenes), kept in
 // tests/data/atlas-quick-references/ (a quarter of a minute each to compute), copied into `dir`:
-// the `--atlas-references` a test's quick atlas reads. ScalingCli.TheKeptQuickReferencesAre
-// TodaysScenes recomputes those at k = 1e3 against them.
+// the `--atlas-references` a test's quick atlas reads. The test
+// ScalingCli.TheKeptQuickReferencesAreTodaysScenes recomputes those at k = 1e3 against them.
 std::filesystem::path quickReferences(const std::filesystem::path& dir);
 
 // Least-squares slope of log(error) against log(dt).
